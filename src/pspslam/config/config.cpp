@@ -1,0 +1,118 @@
+#include "pspslam/config/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <vector>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+namespace {
+
+void require_positive(double value, const YamlSection& section, const std::string& key) {
+  if (!(value > 0.0)) {
+    throw Error(section.file() + ": key '" + section.qualified(key) + "' must be > 0");
+  }
+}
+
+CameraConfig read_camera(YamlSection section) {
+  CameraConfig camera;
+  camera.name = section.optional<std::string>("name", camera.name);
+  PinholeCamera& p = camera.pinhole;
+  p.width = section.required<int>("width");
+  p.height = section.required<int>("height");
+  p.fx = section.required<double>("fx");
+  p.fy = section.required<double>("fy");
+  p.cx = section.required<double>("cx");
+  p.cy = section.required<double>("cy");
+  const auto distortion = section.required<std::vector<double>>("distortion");
+  if (distortion.size() != 4 && distortion.size() != 5) {
+    throw Error(section.file() + ": key '" + section.qualified("distortion") +
+                "' must list 4 or 5 values (k1 k2 p1 p2 [k3]), got " +
+                std::to_string(distortion.size()));
+  }
+  for (size_t i = 0; i < distortion.size(); ++i) p.distortion[i] = distortion[i];
+  camera.fps = section.required<double>("fps");
+  camera.depth_factor = section.required<double>("depth_factor");
+  camera.depth_threshold = section.required<double>("depth_threshold");
+  require_positive(p.width, section, "width");
+  require_positive(p.height, section, "height");
+  require_positive(p.fx, section, "fx");
+  require_positive(p.fy, section, "fy");
+  require_positive(camera.fps, section, "fps");
+  require_positive(camera.depth_factor, section, "depth_factor");
+  require_positive(camera.depth_threshold, section, "depth_threshold");
+  section.finish();
+  return camera;
+}
+
+OrbConfig read_orb(YamlSection section) {
+  OrbConfig orb;
+  orb.n_features = section.optional("n_features", orb.n_features);
+  orb.scale_factor = section.optional("scale_factor", orb.scale_factor);
+  orb.n_levels = section.optional("n_levels", orb.n_levels);
+  orb.initial_fast_threshold = section.optional("initial_fast_threshold", orb.initial_fast_threshold);
+  orb.min_fast_threshold = section.optional("min_fast_threshold", orb.min_fast_threshold);
+  require_positive(orb.n_features, section, "n_features");
+  if (!(orb.scale_factor > 1.0)) {
+    throw Error(section.file() + ": key '" + section.qualified("scale_factor") + "' must be > 1");
+  }
+  require_positive(orb.n_levels, section, "n_levels");
+  section.finish();
+  return orb;
+}
+
+}  // namespace
+
+SystemConfig load_config(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw Error(file.string() + ": config file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw Error(file.string() + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+  }
+  YamlSection top(root, file.string(), "");
+  if (!top.contains("camera")) throw Error(file.string() + ": missing key 'camera'");
+  SystemConfig config;
+  config.camera = read_camera(top.section("camera"));
+  config.orb = read_orb(top.section("orb"));
+  top.finish();
+  return config;
+}
+
+void save_config(const std::filesystem::path& file, const SystemConfig& config) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+  const PinholeCamera& p = config.camera.pinhole;
+  out << YAML::Key << "name" << YAML::Value << config.camera.name;
+  out << YAML::Key << "width" << YAML::Value << p.width;
+  out << YAML::Key << "height" << YAML::Value << p.height;
+  out << YAML::Key << "fx" << YAML::Value << p.fx;
+  out << YAML::Key << "fy" << YAML::Value << p.fy;
+  out << YAML::Key << "cx" << YAML::Value << p.cx;
+  out << YAML::Key << "cy" << YAML::Value << p.cy;
+  out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
+      << std::vector<double>(p.distortion.begin(), p.distortion.end());
+  out << YAML::Key << "fps" << YAML::Value << config.camera.fps;
+  out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
+  out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
+  out << YAML::EndMap;
+  out << YAML::Key << "orb" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "n_features" << YAML::Value << config.orb.n_features;
+  out << YAML::Key << "scale_factor" << YAML::Value << config.orb.scale_factor;
+  out << YAML::Key << "n_levels" << YAML::Value << config.orb.n_levels;
+  out << YAML::Key << "initial_fast_threshold" << YAML::Value << config.orb.initial_fast_threshold;
+  out << YAML::Key << "min_fast_threshold" << YAML::Value << config.orb.min_fast_threshold;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  std::ofstream stream(file);
+  if (!stream) throw Error(file.string() + ": cannot write config file");
+  stream << out.c_str() << "\n";
+}
+
+}  // namespace pspslam

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "pspslam/camera/pinhole_camera.h"
+
+namespace pspslam {
+
+// Sensor description (YAML section `camera:`; all keys but `name` and `k3` are required).
+struct CameraConfig {
+  std::string name = "unnamed";
+  PinholeCamera pinhole;
+  double fps = 30.0;
+  double depth_factor = 5000.0;   // depth image units per metre (5000 for TUM and Bonn)
+  double depth_threshold = 4.0;   // metres: closer points are "close" (reliable) points
+};
+
+// ORB extractor parameters as ORB-SLAM2 defines them (YAML section `orb:`, all optional).
+struct OrbConfig {
+  int n_features = 1000;
+  double scale_factor = 1.2;
+  int n_levels = 8;
+  int initial_fast_threshold = 20;
+  int min_fast_threshold = 7;
+};
+
+struct SystemConfig {
+  CameraConfig camera;
+  OrbConfig orb;
+};
+
+// Loads a config file. Any missing required key, unknown key or invalid value raises
+// pspslam::Error naming the file, the line and the key.
+SystemConfig load_config(const std::filesystem::path& file);
+
+// Writes a config that load_config reads back to the same values.
+void save_config(const std::filesystem::path& file, const SystemConfig& config);
+
+}  // namespace pspslam

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace pspslam::testing {
+
+// The ../shared folder, or std::nullopt-like empty path when it is absent.
+std::filesystem::path shared_dir_if_present();
+
+// True when PSPSLAM_REQUIRE_SHARED=1 (set by .ci/run): then a missing ../shared is a failure.
+bool shared_required();
+
+// A fresh, empty temporary directory unique to the running test.
+std::filesystem::path make_temp_dir(const std::string& tag);
+
+// Runs a shell command, returns its exit status; stdout+stderr land in *output.
+int run_shell(const std::string& command, std::string* output);
+
+}  // namespace pspslam::testing
+
+// Use at the top of a test that reads ../shared:
+//   PSPSLAM_SHARED_OR_SKIP(shared);   // declares `std::filesystem::path shared`
+// Skips with the reason when ../shared is missing, fails instead under PSPSLAM_REQUIRE_SHARED=1.
+#define PSPSLAM_SHARED_OR_SKIP(var)                                                         \
+  const std::filesystem::path var = ::pspslam::testing::shared_dir_if_present();           \
+  if (var.empty()) {                                                                        \
+    if (::pspslam::testing::shared_required()) {                                            \
+      FAIL() << "../shared is required (PSPSLAM_REQUIRE_SHARED=1) but was not found; set "  \
+                "PSPSLAM_SHARED";                                                           \
+    }                                                                                       \
+    GTEST_SKIP() << "../shared not found (set PSPSLAM_SHARED to its path); skipping test "  \
+                    "that needs real data";                                                 \
+  }

@@ -10,5 +10,6 @@ namespace pspslam::cli {
 int run_command(const std::vector<std::string>& args);
 int eval_command(const std::vector<std::string>& args);
 int synth_command(const std::vector<std::string>& args);
+int segment_command(const std::vector<std::string>& args);
 
 }  // namespace pspslam::cli

@@ -20,6 +20,8 @@ const std::vector<Command>& commands() {
       {"eval", "ATE / RPE of an estimated trajectory against ground truth",
        pspslam::cli::eval_command},
       {"synth", "render a synthetic dynamic RGB-D sequence", pspslam::cli::synth_command},
+      {"segment", "segment images with an ONNX network (overlays, masks, timing)",
+       pspslam::cli::segment_command},
   };
   return table;
 }

@@ -1,0 +1,201 @@
+// Accuracy / cost of the geometry module (paper III.C) on the analytic synthetic scene with
+// ground-truth labels (pspslam::SyntheticScene). Plain table output; see docs/geometry.md.
+//
+//   bench_geometry_synthetic [--frames N] [--seeds S] [--width W] [--sweep NAME] [--key value ...]
+//
+// Keys override GeometryParams fields by name (e.g. --depth_threshold_relative 0.03).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/geometry/synthetic_scene.h"
+
+namespace {
+
+using namespace pspslam;
+
+struct Metrics {
+  long tp = 0, fp = 0, fn = 0, tn = 0;          // final per-keypoint flags
+  long test_tp = 0, test_fp = 0, test_fn = 0;   // tested-dynamic flags only
+  long tested = 0, candidates = 0;
+  std::vector<double> total_ms;
+  void add(const Metrics& o) {
+    tp += o.tp; fp += o.fp; fn += o.fn; tn += o.tn;
+    test_tp += o.test_tp; test_fp += o.test_fp; test_fn += o.test_fn;
+    tested += o.tested; candidates += o.candidates;
+    total_ms.insert(total_ms.end(), o.total_ms.begin(), o.total_ms.end());
+  }
+  double recall() const { return tp + fn ? double(tp) / (tp + fn) : 1.0; }
+  double precision() const { return tp + fp ? double(tp) / (tp + fp) : 1.0; }
+  double test_recall() const { return test_tp + test_fn ? double(test_tp) / (test_tp + test_fn) : 1.0; }
+  double test_precision() const { return test_tp + test_fp ? double(test_tp) / (test_tp + test_fp) : 1.0; }
+  double median_ms() const {
+    if (total_ms.empty()) return 0.0;
+    std::vector<double> v = total_ms;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  }
+};
+
+struct Options {
+  int frames = 6;
+  int seeds = 3;
+  int width = 640;
+  int keypoints = 1000;
+  double pose_noise_mm = 0.0;
+  double pose_noise_deg = 0.0;
+  std::map<std::string, double> overrides;
+};
+
+void apply(GeometryParams& p, const std::string& key, double value) {
+  if (key == "depth_threshold_abs_m") p.multiview.depth_threshold_abs_m = value;
+  else if (key == "depth_threshold_relative") p.multiview.depth_threshold_relative = value;
+  else if (key == "either_sign") p.multiview.disagreement = value > 0 ? DepthDisagreement::either_sign : DepthDisagreement::farther_only;
+  else if (key == "max_parallax_deg") p.multiview.max_parallax_deg = value;
+  else if (key == "reference_patch_radius") p.multiview.reference_patch_radius = int(value);
+  else if (key == "min_dynamic_vote_fraction") p.multiview.min_dynamic_vote_fraction = value;
+  else if (key == "max_reference_views") p.multiview.max_reference_views = int(value);
+  else if (key == "search_radius_px") p.search.search_radius_px = float(value);
+  else if (key == "band_width_px") p.search.band_width_px = float(value);
+  else if (key == "node_spacing_px") p.search.node_spacing_px = float(value);
+  else if (key == "lane_spacing_px") p.search.lane_spacing_px = float(value);
+  else if (key == "exhaustive") p.search.strategy = value > 0 ? SearchStrategy::exhaustive : SearchStrategy::ant_colony;
+  else if (key == "region") p.region.enabled = value > 0;
+  else if (key == "stride") p.region.stride = int(value);
+  else if (key == "max_step_abs_m") p.region.max_step_abs_m = value;
+  else if (key == "max_step_relative") p.region.max_step_relative = value;
+  else if (key == "max_depth_from_seed_m") p.region.max_depth_from_seed_m = value;
+  else if (key == "static_barrier_radius_px") p.region.static_barrier_radius_px = float(value);
+  else if (key == "max_grow_radius_px") p.region.max_grow_radius_px = float(value);
+  else if (key == "min_seeds_per_region") p.region.min_seeds_per_region = int(value);
+  else if (key == "dilation_px") p.region.dilation_px = int(value);
+  else {
+    std::fprintf(stderr, "unknown key %s\n", key.c_str());
+    std::exit(2);
+  }
+}
+
+Pose perturbed(const Pose& T, double mm, double deg, std::mt19937_64& rng) {
+  if (mm <= 0.0 && deg <= 0.0) return T;
+  std::normal_distribution<double> n(0.0, 1.0);
+  Pose d = Pose::Identity();
+  d.translation() = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * mm * 1e-3;
+  d.linear() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
+                   .toRotationMatrix();
+  return T * d;
+}
+
+Metrics evaluate(const GeometryParams& params, const Options& o) {
+  Metrics total;
+  PinholeCamera camera;
+  const double scale = o.width / 640.0;
+  camera.width = o.width;
+  camera.height = int(480 * scale);
+  camera.fx = camera.fy = 525.0 * scale;
+  camera.cx = camera.width / 2.0 - 0.5;
+  camera.cy = camera.height / 2.0 - 0.5;
+  for (int seed = 1; seed <= o.seeds; ++seed) {
+    SyntheticSceneParams sp;
+    sp.camera = camera;
+    sp.seed = seed;
+    const SyntheticScene scene(sp);
+    GeometryStage stage(camera, params);
+    std::mt19937_64 rng(seed * 77);
+    for (int f = 0; f < o.frames; ++f) {
+      const int current = 50 + 7 * f;
+      std::vector<DepthView> references;
+      cv::Mat depth, labels;
+      for (int k = 1; k <= 5; ++k) {
+        scene.render(current - 10 * k, depth, labels);
+        references.push_back({perturbed(scene.camera_pose(current - 10 * k), o.pose_noise_mm,
+                                        o.pose_noise_deg, rng),
+                              depth.clone()});
+      }
+      scene.render(current, depth, labels);
+      const std::vector<Eigen::Vector2d> keypoints =
+          sample_candidate_pixels(depth, o.keypoints, seed * 1000 + f);
+      GeometryFrameInput input;
+      input.depth = depth;
+      input.T_world_camera = perturbed(scene.camera_pose(current), o.pose_noise_mm, o.pose_noise_deg, rng);
+      input.keypoints = keypoints;
+      input.references = references;
+      timespec cpu_start{}, cpu_end{};
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu_start);
+      const GeometryFrameResult r = stage.process(input);
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu_end);
+      Metrics m;
+      for (size_t i = 0; i < keypoints.size(); ++i) {
+        const bool truth = labels.at<std::uint8_t>(int(keypoints[i].y()), int(keypoints[i].x())) != 0;
+        const bool flag = r.keypoint_dynamic[i];
+        const bool tested_flag = r.keypoint_tested_dynamic[i];
+        m.tp += truth && flag; m.fp += !truth && flag; m.fn += truth && !flag; m.tn += !truth && !flag;
+        m.test_tp += truth && tested_flag; m.test_fp += !truth && tested_flag; m.test_fn += truth && !tested_flag;
+      }
+      m.tested = r.tested_count;
+      m.candidates = long(keypoints.size());
+      // Thread CPU time: the machine is shared (load ~7 per core), wall time mostly measures that.
+      m.total_ms.push_back((cpu_end.tv_sec - cpu_start.tv_sec) * 1e3 +
+                           (cpu_end.tv_nsec - cpu_start.tv_nsec) * 1e-6);
+      total.add(m);
+    }
+  }
+  return total;
+}
+
+void print_header() {
+  std::printf("%-34s %7s %7s %7s %7s %7s %8s\n", "setting", "recall", "prec", "t_rec", "t_prec",
+              "tested", "cpu_ms");
+}
+void print_row(const std::string& name, const Metrics& m) {
+  std::printf("%-34s %7.3f %7.3f %7.3f %7.3f %7.3f %8.2f\n", name.c_str(), m.recall(),
+              m.precision(), m.test_recall(), m.test_precision(),
+              double(m.tested) / std::max(1L, m.candidates), m.median_ms());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  std::string sweep;
+  std::vector<std::pair<std::string, double>> overrides;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string key = std::string(argv[i]).substr(2);
+    const std::string value = argv[i + 1];
+    if (key == "frames") o.frames = std::stoi(value);
+    else if (key == "seeds") o.seeds = std::stoi(value);
+    else if (key == "width") o.width = std::stoi(value);
+    else if (key == "keypoints") o.keypoints = std::stoi(value);
+    else if (key == "pose_noise_mm") o.pose_noise_mm = std::stod(value);
+    else if (key == "pose_noise_deg") o.pose_noise_deg = std::stod(value);
+    else if (key == "sweep") sweep = value;
+    else overrides.emplace_back(key, std::stod(value));
+  }
+  GeometryParams base;
+  for (const auto& [k, v] : overrides) apply(base, k, v);
+  print_header();
+  if (sweep.empty()) {
+    print_row("current", evaluate(base, o));
+    return 0;
+  }
+  // --sweep key:v1,v2,v3
+  const size_t colon = sweep.find(':');
+  const std::string key = sweep.substr(0, colon);
+  std::string list = sweep.substr(colon + 1);
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t comma = list.find(',', start);
+    const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    GeometryParams p = base;
+    apply(p, key, std::stod(item));
+    print_row(key + "=" + item, evaluate(p, o));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return 0;
+}

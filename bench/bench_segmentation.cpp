@@ -1,0 +1,177 @@
+// Segmentation accuracy and speed through the C++ path (OpenCV DNN, CPU).
+//
+//   bench_segmentation [--models a.yaml,b.yaml] [--threads 2] [--frames 20] [--no-iou]
+//                      [google-benchmark flags]
+//
+// 1. Prints the person IoU (mean over the human_seg validation split of
+//    models/pspnet/human_seg_split.json, masks resized to the photo) of each model.
+// 2. Times segment() on bonn_crowd_dev frames (640x480, including pre/post-processing) with
+//    cv::setNumThreads(threads); the counter median_ms is the median over --frames frames.
+// Needs ../shared (PSPSLAM_SHARED); defaults to our PSPNet at both exported sizes and the
+// three teachers.
+#include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pspslam/core/error.h"
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/semantic/onnx_segmenter.h"
+
+namespace {
+
+using pspslam::OnnxSegmenter;
+namespace fs = std::filesystem;
+
+struct Options {
+  std::vector<fs::path> models;
+  int threads = 2;
+  int frames = 20;
+  bool iou = true;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double validation_iou(OnnxSegmenter& segmenter, const fs::path& shared, int* count) {
+  const YAML::Node split = YAML::LoadFile(
+      (pspslam::source_dir() / "models" / "pspnet" / "human_seg_split.json").string());
+  double sum = 0;
+  *count = 0;
+  for (int id : split["val"].as<std::vector<int>>()) {
+    const fs::path root = shared / "data" / "human_seg";
+    const cv::Mat bgr = cv::imread((root / "images" / (std::to_string(id) + ".jpg")).string());
+    cv::Mat gt = cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(),
+                            cv::IMREAD_GRAYSCALE);
+    if (bgr.empty() || gt.empty()) throw pspslam::Error("human_seg sample " + std::to_string(id));
+    if (gt.size() != bgr.size()) cv::resize(gt, gt, bgr.size(), 0, 0, cv::INTER_NEAREST);
+    const cv::Mat pred = segmenter.segment(bgr) == 15;
+    const cv::Mat truth = gt > 127;
+    const double uni = cv::countNonZero(pred | truth);
+    sum += uni == 0 ? 1.0 : cv::countNonZero(pred & truth) / uni;
+    ++*count;
+  }
+  return sum / *count;
+}
+
+std::vector<cv::Mat> bonn_frames(const fs::path& shared, int count) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(shared / "data" / "bonn_crowd_dev" / "rgb")) {
+    files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<cv::Mat> frames;
+  // Frames with people (from ~220 on), spread over the clip.
+  for (size_t i = 220; i < files.size() && static_cast<int>(frames.size()) < count; i += 8) {
+    frames.push_back(cv::imread(files[i].string()));
+  }
+  return frames;
+}
+
+Options parse(int* argc, char** argv) {
+  Options o;
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < *argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= *argc) throw pspslam::Error("flag " + a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--models") {
+      std::stringstream list(value());
+      for (std::string m; std::getline(list, m, ',');) o.models.emplace_back(m);
+    } else if (a == "--threads") {
+      o.threads = std::stoi(value());
+    } else if (a == "--frames") {
+      o.frames = std::stoi(value());
+    } else if (a == "--no-iou") {
+      o.iou = false;
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  for (size_t i = 0; i < rest.size(); ++i) argv[i] = rest[i];
+  *argc = static_cast<int>(rest.size());
+  if (o.models.empty()) {
+    const fs::path src = pspslam::source_dir() / "models";
+    o.models = {src / "pspnet" / "pspnet.yaml", src / "pspnet" / "pspnet_288x192.yaml",
+                src / "teachers" / "deeplabv3_mnv2_pascal.yaml",
+                src / "teachers" / "deeplabv3_mnv2_dm05_pascal.yaml",
+                src / "teachers" / "espnetv2_s2.0_pascal_384x384.yaml"};
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options options = parse(&argc, argv);
+    const fs::path shared = pspslam::shared_dir();
+    if (!fs::exists(shared / "data" / "human_seg")) {
+      std::cerr << "bench_segmentation needs ../shared (set PSPSLAM_SHARED)\n";
+      return 2;
+    }
+    cv::setNumThreads(options.threads);
+    const std::vector<cv::Mat> frames = bonn_frames(shared, options.frames);
+    if (options.iou) {
+      std::printf("%-34s %-9s %s\n", "model", "input", "person IoU (human_seg validation)");
+      for (const fs::path& m : options.models) {
+        auto segmenter = OnnxSegmenter::from_file(m);
+        int count = 0;
+        const double iou = validation_iou(*segmenter, shared, &count);
+        const auto& meta = segmenter->metadata();
+        std::printf("%-34s %4dx%-4d %.4f (%d photos)\n", meta.name.c_str(), meta.input_width,
+                    meta.input_height, iou, count);
+        std::fflush(stdout);
+      }
+    }
+    for (const fs::path& m : options.models) {
+      auto meta = pspslam::load_segmenter_metadata(m);
+      const std::string name = meta.name + "/" + std::to_string(meta.input_width) + "x" +
+                               std::to_string(meta.input_height) + "/threads:" +
+                               std::to_string(options.threads);
+      benchmark::RegisterBenchmark(
+          name.c_str(),
+          [meta, &frames](benchmark::State& state) {
+            OnnxSegmenter segmenter(meta);
+            segmenter.segment(frames.front());  // one-off set-up outside the timing
+            std::vector<double> ms;
+            size_t i = 0;
+            for (auto _ : state) {
+              const auto t0 = std::chrono::steady_clock::now();
+              benchmark::DoNotOptimize(segmenter.segment(frames[i++ % frames.size()]));
+              ms.push_back(std::chrono::duration<double, std::milli>(
+                               std::chrono::steady_clock::now() - t0)
+                               .count());
+            }
+            state.counters["median_ms"] = median(ms);
+            state.counters["frames"] = static_cast<double>(ms.size());
+          })
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(static_cast<benchmark::IterationCount>(frames.size()))
+          ->UseRealTime();
+    }
+    benchmark::Initialize(&argc, argv);
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+  } catch (const pspslam::Error& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

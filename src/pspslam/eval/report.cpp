@@ -1,0 +1,110 @@
+#include "pspslam/eval/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace pspslam {
+namespace {
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string short_number(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%g", value);
+  return buffer;
+}
+
+std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_stats(const ErrorStats& s) {
+  return "{\"count\": " + std::to_string(s.count) + ", \"rmse\": " + json_number(s.rmse) +
+         ", \"mean\": " + json_number(s.mean) + ", \"median\": " + json_number(s.median) +
+         ", \"std\": " + json_number(s.std) + ", \"min\": " + json_number(s.min) +
+         ", \"max\": " + json_number(s.max) + "}";
+}
+
+std::string table_row(const std::string& name, const std::string& unit, const ErrorStats& s,
+                      int decimals) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), "  %-22s %-6s %6zu %10s %10s %10s %10s %10s %10s\n",
+                name.c_str(), unit.c_str(), s.count, fixed(s.rmse, decimals).c_str(),
+                fixed(s.mean, decimals).c_str(), fixed(s.median, decimals).c_str(),
+                fixed(s.std, decimals).c_str(), fixed(s.min, decimals).c_str(),
+                fixed(s.max, decimals).c_str());
+  return buffer;
+}
+
+}  // namespace
+
+std::string format_eval_table(const EvalSettings& settings, const AteResult& ate,
+                              const RpeResult& rpe) {
+  std::ostringstream out;
+  out << "ground truth: " << settings.ground_truth_file << "\n";
+  out << "estimate:     " << settings.estimate_file << "\n";
+  out << "association:  max dt " << short_number(settings.ate.max_difference) << " s, offset "
+      << short_number(settings.ate.offset) << " s\n";
+  out << "alignment:    " << (settings.ate.sim3 ? "Sim(3)" : "SE(3)") << ", scale "
+      << fixed(ate.alignment.scale, 6) << "\n";
+  out << "RPE delta:    " << short_number(settings.rpe.delta) << " "
+      << (settings.rpe.unit == RpeDeltaUnit::seconds ? "s" : "frames") << "\n\n";
+  char header[256];
+  std::snprintf(header, sizeof(header), "  %-22s %-6s %6s %10s %10s %10s %10s %10s %10s\n",
+                "metric", "unit", "pairs", "rmse", "mean", "median", "std", "min", "max");
+  out << header;
+  out << table_row("ATE", "m", ate.error, 4);
+  out << table_row("RPE translation", "m", rpe.translation, 4);
+  out << table_row("RPE translation rate", "m/s", rpe.translation_per_second, 4);
+  out << table_row("RPE rotation", "deg", rpe.rotation, 3);
+  out << table_row("RPE rotation rate", "deg/s", rpe.rotation_per_second, 3);
+  return out.str();
+}
+
+std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
+                             const RpeResult& rpe) {
+  std::ostringstream out;
+  out << "{\n";
+  out << "  \"ground_truth\": " << json_string(settings.ground_truth_file) << ",\n";
+  out << "  \"estimate\": " << json_string(settings.estimate_file) << ",\n";
+  out << "  \"ate\": {\"alignment\": \"" << (settings.ate.sim3 ? "sim3" : "se3")
+      << "\", \"max_dt_s\": " << json_number(settings.ate.max_difference)
+      << ", \"offset_s\": " << json_number(settings.ate.offset)
+      << ", \"scale\": " << json_number(ate.alignment.scale)
+      << ", \"error_m\": " << json_stats(ate.error) << "},\n";
+  out << "  \"rpe\": {\"delta\": " << json_number(settings.rpe.delta) << ", \"delta_unit\": \""
+      << to_string(settings.rpe.unit) << "\",\n";
+  out << "          \"translation_m\": " << json_stats(rpe.translation) << ",\n";
+  out << "          \"translation_m_per_s\": " << json_stats(rpe.translation_per_second) << ",\n";
+  out << "          \"rotation_deg\": " << json_stats(rpe.rotation) << ",\n";
+  out << "          \"rotation_deg_per_s\": " << json_stats(rpe.rotation_per_second) << "}\n";
+  out << "}\n";
+  return out.str();
+}
+
+}  // namespace pspslam

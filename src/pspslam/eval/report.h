@@ -1,0 +1,27 @@
+#pragma once
+
+#include <string>
+
+#include "pspslam/eval/ate.h"
+#include "pspslam/eval/rpe.h"
+
+namespace pspslam {
+
+// What was evaluated and how, echoed in reports so a result is never separated from its settings.
+struct EvalSettings {
+  std::string ground_truth_file;
+  std::string estimate_file;
+  AteOptions ate;
+  RpeOptions rpe;
+};
+
+// Human-readable ATE/RPE table (fixed-width, units in every row).
+std::string format_eval_table(const EvalSettings& settings, const AteResult& ate,
+                              const RpeResult& rpe);
+
+// The same numbers as one JSON object (numbers printed with 17 significant digits so they
+// compare bit-for-bit with other tools; non-finite values as null).
+std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
+                             const RpeResult& rpe);
+
+}  // namespace pspslam

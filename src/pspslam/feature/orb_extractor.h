@@ -1,0 +1,105 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <vector>
+
+#include "pspslam/config/config.h"
+#include "pspslam/feature/brief_pattern.h"
+#include "pspslam/feature/hamming.h"
+#include "pspslam/feature/keypoint_distribution.h"
+
+namespace pspslam {
+
+// Keypoints and their descriptors, row i of `descriptors` describes keypoints[i].
+struct OrbFeatures {
+  // Level-0 pixel coordinates (not undistorted); octave = pyramid level, size = 31 * scale of the
+  // level, angle in degrees [0, 360), response = FAST score.
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  // keypoints.size() x kOrbDescriptorBytes, CV_8UC1
+};
+
+// ORB features as ORB-SLAM2 defines them: a scale pyramid, FAST corners detected per grid cell
+// with a fallback threshold for cells that yield nothing, a quadtree that spreads each level's
+// share of features over the image, intensity-centroid orientation and rotated 256-bit BRIEF on
+// the Gaussian-smoothed level.
+//
+// Not thread-safe: one extractor per thread. It keeps its pyramid and scratch buffers between
+// calls, so extracting frames of the same size does not reallocate images.
+class OrbExtractor {
+ public:
+  // Throws pspslam::Error when the config is unusable (non-positive counts, scale <= 1,
+  // thresholds outside 1..255 or min > initial).
+  explicit OrbExtractor(const OrbConfig& config);
+  // Same with another sampling pattern (pattern learning and experiments; the default is
+  // make_learned_brief_pattern()).
+  OrbExtractor(const OrbConfig& config, const BriefPattern& pattern);
+
+  // gray: CV_8UC1. ignore_mask: empty, or CV_8UC1 of gray's size where non-zero pixels are
+  // ignored (dynamic regions): no keypoint is returned whose level-0 position (rounded) falls on
+  // one. `out` is overwritten; the capacity of its vector and its descriptor matrix are reused.
+  // Throws pspslam::Error for a wrong image type or a mask of another size/type.
+  void extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbFeatures& out);
+
+  int levels() const { return static_cast<int>(scale_factors_.size()); }
+  const OrbConfig& config() const { return config_; }
+  // scale_factors()[l] = scale_factor^l: level-0 coordinate = level coordinate * scale.
+  const std::vector<float>& scale_factors() const { return scale_factors_; }
+  const std::vector<float>& inv_scale_factors() const { return inv_scale_factors_; }
+  // Variance of a keypoint position measured on level l, in level-0 pixels^2 (scale^2): the
+  // weight of reprojection errors in optimisation and the tolerance of matching windows.
+  const std::vector<float>& level_sigma2() const { return level_sigma2_; }
+  const std::vector<float>& inv_level_sigma2() const { return inv_level_sigma2_; }
+  // How many of config().n_features each level aims for (geometric in 1/scale, summing to
+  // n_features): a level of half the area gets roughly half the features.
+  const std::vector<int>& features_per_level() const { return features_per_level_; }
+  // Pyramid level l of the last extracted image (a view into the extractor's buffer, valid
+  // until the next extract()).
+  const cv::Mat& level_image(int level) const { return pyramid_[level].image; }
+
+ private:
+  struct PyramidLevel {
+    cv::Mat padded;          // level image plus a reflected border (descriptor patches at edges)
+    cv::Mat image;           // view of padded without the border
+    cv::Mat blurred_padded;  // padded, Gaussian-smoothed: BRIEF tests are run on this
+    cv::Mat blurred;         // view of blurred_padded without the border
+  };
+
+  void build_pyramid(const cv::Mat& gray);
+  // FAST candidates of one level that are not masked; cells without any corner at the initial
+  // threshold are searched again with the minimum threshold.
+  void detect_candidates(int level, const cv::Mat& ignore_mask);
+  bool is_ignored(const cv::Mat& ignore_mask, float level_x, float level_y, float scale) const;
+  float orientation_degrees(const cv::Mat& image, const cv::Point2f& position) const;
+  void describe(const cv::Mat& blurred, const cv::KeyPoint& keypoint,
+                std::uint8_t* descriptor) const;
+
+  OrbConfig config_;
+  std::vector<float> scale_factors_;
+  std::vector<float> inv_scale_factors_;
+  std::vector<float> level_sigma2_;
+  std::vector<float> inv_level_sigma2_;
+  std::vector<int> features_per_level_;
+  // umax_[v]: half-width of the circular orientation patch at row offset v.
+  std::array<int, 16> umax_{};
+  BriefPattern pattern_;
+  // pattern_ rotated to each of a fixed set of angles, as integer pixel offsets.
+  struct RotatedPair {
+    std::int8_t first_x = 0;
+    std::int8_t first_y = 0;
+    std::int8_t second_x = 0;
+    std::int8_t second_y = 0;
+  };
+  std::vector<RotatedPair> rotated_pattern_;
+
+  std::vector<PyramidLevel> pyramid_;
+  std::vector<cv::KeyPoint> fast_keypoints_;
+  std::vector<cv::KeyPoint> candidates_;
+  std::vector<cv::KeyPoint> selected_;
+  std::vector<int> cell_counts_;
+  QuadtreeDistributor distributor_;
+  cv::Mat blur_scratch_;
+};
+
+}  // namespace pspslam

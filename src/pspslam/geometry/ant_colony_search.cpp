@@ -1,0 +1,178 @@
+#include "pspslam/geometry/ant_colony_search.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+#include "pspslam/geometry/convex_hull.h"
+
+namespace pspslam {
+namespace {
+
+void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
+  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+}
+
+}  // namespace
+
+AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
+  AntColonyParams p;
+  const std::string strategy = section.optional<std::string>("strategy", "ant_colony");
+  if (strategy == "ant_colony") {
+    p.strategy = SearchStrategy::ant_colony;
+  } else if (strategy == "exhaustive") {
+    p.strategy = SearchStrategy::exhaustive;
+  } else {
+    throw Error(section.file() + ": key '" + section.qualified("strategy") + "' must be " +
+                "ant_colony or exhaustive, not '" + strategy + "'");
+  }
+  p.search_radius_px = section.optional("search_radius_px", p.search_radius_px);
+  require(p.search_radius_px > 0.0f, section, "search_radius_px", "must be > 0");
+  p.band_width_px = section.optional("band_width_px", p.band_width_px);
+  require(p.band_width_px > 0.0f, section, "band_width_px", "must be > 0");
+  p.node_spacing_px = section.optional("node_spacing_px", p.node_spacing_px);
+  require(p.node_spacing_px > 0.0f, section, "node_spacing_px", "must be > 0");
+  p.lane_spacing_px = section.optional("lane_spacing_px", p.lane_spacing_px);
+  require(p.lane_spacing_px > 0.0f, section, "lane_spacing_px", "must be > 0");
+  p.max_band_rounds = section.optional("max_band_rounds", p.max_band_rounds);
+  require(p.max_band_rounds >= 1, section, "max_band_rounds", "must be >= 1");
+  section.finish();
+  return p;
+}
+
+DynamicPointSearch::DynamicPointSearch(AntColonyParams params) : params_(params) {}
+
+void DynamicPointSearch::build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size) {
+  // Cells of side R: a radius-R query touches at most 3x3 cells.
+  cell_size_ = std::max(params_.search_radius_px, 4.0f);
+  grid_cols_ = std::max(1, static_cast<int>(std::ceil(image_size.width / cell_size_)));
+  grid_rows_ = std::max(1, static_cast<int>(std::ceil(image_size.height / cell_size_)));
+  const size_t cells = static_cast<size_t>(grid_cols_) * grid_rows_;
+  cell_start_.assign(cells + 1, 0);
+  point_cell_.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const int col = std::clamp(static_cast<int>(points[i].x() / cell_size_), 0, grid_cols_ - 1);
+    const int row = std::clamp(static_cast<int>(points[i].y() / cell_size_), 0, grid_rows_ - 1);
+    point_cell_[i] = row * grid_cols_ + col;
+    ++cell_start_[point_cell_[i] + 1];
+  }
+  for (size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_points_.resize(points.size());
+  cell_cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  for (size_t i = 0; i < points.size(); ++i) {
+    cell_points_[cell_cursor_[point_cell_[i]]++] = static_cast<int>(i);
+  }
+}
+
+void DynamicPointSearch::build_path(cv::Size image_size) {
+  if (image_size == path_size_ && !path_nodes_.empty()) return;
+  path_size_ = image_size;
+  path_nodes_.clear();
+  // Boustrophedon path L from A (top-left) to B: lanes left-to-right then right-to-left, so
+  // consecutive nodes K_i, K_{i+1} are always one node spacing apart (paper Fig. 6).
+  const float half_lane = params_.lane_spacing_px / 2.0f;
+  bool left_to_right = true;
+  for (float y = half_lane; y < image_size.height; y += params_.lane_spacing_px) {
+    std::vector<float> xs;
+    for (float x = params_.node_spacing_px / 2.0f; x < image_size.width; x += params_.node_spacing_px)
+      xs.push_back(x);
+    if (!left_to_right) std::reverse(xs.begin(), xs.end());
+    for (float x : xs) path_nodes_.emplace_back(x, y);
+    left_to_right = !left_to_right;
+  }
+}
+
+bool DynamicPointSearch::test(int index, const PointPredicate& is_dynamic) {
+  result_.tested[index] = 1;
+  ++result_.tested_count;
+  const bool dynamic = is_dynamic(index);
+  if (dynamic) {
+    result_.dynamic[index] = 1;
+    ++result_.dynamic_count;
+  }
+  return dynamic;
+}
+
+void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
+                                        const PointPredicate& is_dynamic) {
+  ++result_.communities;
+  const float band = params_.band_width_px;
+  for (int round = 0; round < params_.max_band_rounds; ++round) {
+    ++result_.band_rounds;
+    convex_hull(community_, hull_scratch_, hull_);
+    Eigen::Vector2f lo = hull_[0], hi = hull_[0];
+    for (const Eigen::Vector2f& v : hull_) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    const int col0 = std::clamp(static_cast<int>((lo.x() - band) / cell_size_), 0, grid_cols_ - 1);
+    const int col1 = std::clamp(static_cast<int>((hi.x() + band) / cell_size_), 0, grid_cols_ - 1);
+    const int row0 = std::clamp(static_cast<int>((lo.y() - band) / cell_size_), 0, grid_rows_ - 1);
+    const int row1 = std::clamp(static_cast<int>((hi.y() + band) / cell_size_), 0, grid_rows_ - 1);
+    found_.clear();
+    // The band is every untested point within dZ of the hull, interior included: points the hull
+    // swallowed in one jump would otherwise never be tested.
+    for (int row = row0; row <= row1; ++row) {
+      for (int col = col0; col <= col1; ++col) {
+        const int cell = row * grid_cols_ + col;
+        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+          const int index = cell_points_[k];
+          if (result_.tested[index]) continue;
+          if (distance_to_convex_hull(hull_, points[index]) > band) continue;
+          if (test(index, is_dynamic)) found_.push_back(index);
+        }
+      }
+    }
+    if (found_.empty()) return;  // a band without new dynamic points ends this community
+    for (int index : found_) community_.push_back(points[index]);
+  }
+}
+
+const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> points,
+                                            cv::Size image_size, const PointPredicate& is_dynamic,
+                                            std::span<const int> priority) {
+  const size_t n = points.size();
+  result_.dynamic.assign(n, 0);
+  result_.tested.assign(n, 0);
+  result_.tested_count = result_.dynamic_count = result_.communities = result_.band_rounds = 0;
+  if (n == 0) return result_;
+
+  if (params_.strategy == SearchStrategy::exhaustive) {
+    for (size_t i = 0; i < n; ++i) test(static_cast<int>(i), is_dynamic);
+    return result_;
+  }
+
+  build_grid(points, image_size);
+  build_path(image_size);
+
+  for (int index : priority) {
+    if (index < 0 || static_cast<size_t>(index) >= n || result_.tested[index]) continue;
+    if (!test(index, is_dynamic)) continue;
+    community_.assign(1, points[index]);
+    grow_community(points, is_dynamic);
+  }
+
+  const float radius2 = params_.search_radius_px * params_.search_radius_px;
+  for (const Eigen::Vector2f& node : path_nodes_) {
+    const int col = std::clamp(static_cast<int>(node.x() / cell_size_), 0, grid_cols_ - 1);
+    const int row = std::clamp(static_cast<int>(node.y() / cell_size_), 0, grid_rows_ - 1);
+    community_.clear();
+    for (int r = std::max(0, row - 1); r <= std::min(grid_rows_ - 1, row + 1); ++r) {
+      for (int c = std::max(0, col - 1); c <= std::min(grid_cols_ - 1, col + 1); ++c) {
+        const int cell = r * grid_cols_ + c;
+        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+          const int index = cell_points_[k];
+          if (result_.tested[index]) continue;
+          if ((points[index] - node).squaredNorm() > radius2) continue;
+          if (test(index, is_dynamic)) community_.push_back(points[index]);
+        }
+      }
+    }
+    // A find leaves the path: grow this community's hull, then go on at K_{i+1}.
+    if (!community_.empty()) grow_community(points, is_dynamic);
+  }
+  return result_;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,84 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <span>
+#include <vector>
+
+namespace pspslam {
+
+class YamlSection;
+
+enum class SearchStrategy {
+  ant_colony,  // paper Fig. 6: test along a meandering path, grow convex hulls around finds
+  exhaustive,  // DynaSLAM baseline: test every point
+};
+
+// Parameters of the reverse ant-colony search (paper III.C, Fig. 6). Defaults: docs/geometry.md.
+struct AntColonyParams {
+  SearchStrategy strategy = SearchStrategy::ant_colony;
+  float search_radius_px = 12.0f;  // R: points within R of a path node K_i are tested
+  float band_width_px = 20.0f;     // dZ: band around a community's convex hull tested per round
+  float node_spacing_px = 16.0f;   // s: distance between consecutive nodes along a lane
+  float lane_spacing_px = 48.0f;   // distance between the boustrophedon lanes of the path L
+  int max_band_rounds = 256;       // safety bound; a round that finds nothing ends growth anyway
+
+  // Reads the optional keys of a `search:` section (strategy: ant_colony | exhaustive).
+  static AntColonyParams from_yaml(YamlSection& section);
+};
+
+struct SearchResult {
+  std::vector<std::uint8_t> dynamic;  // 1 = tested and found dynamic; untested count as static
+  std::vector<std::uint8_t> tested;
+  int tested_count = 0;
+  int dynamic_count = 0;
+  int communities = 0;  // dynamic clusters grown from a path node or a priority point
+  int band_rounds = 0;  // hull-band rounds over all communities
+};
+
+// Index of a candidate point -> is it dynamic (the multi-view test). Called at most once per point.
+using PointPredicate = std::function<bool(int)>;
+
+// Reusable searcher: buffers (grid buckets, hull, community) are kept between frames so a frame
+// costs no allocation once sizes have settled. Not thread-safe; use one per worker thread.
+class DynamicPointSearch {
+ public:
+  explicit DynamicPointSearch(AntColonyParams params = {});
+
+  // `points` are pixel positions inside `image_size`. `priority` indices (e.g. points inside the
+  // previous frame's dynamic mask warped by the compensated homography) are tested before the
+  // path, each a potential community seed. The returned reference stays valid until the next run.
+  const SearchResult& run(std::span<const Eigen::Vector2f> points, cv::Size image_size,
+                          const PointPredicate& is_dynamic, std::span<const int> priority = {});
+
+  const AntColonyParams& params() const { return params_; }
+
+ private:
+  void build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size);
+  void build_path(cv::Size image_size);
+  bool test(int index, const PointPredicate& is_dynamic);
+  // Grows the community whose first dynamic points are in community_ until a band adds nothing.
+  void grow_community(std::span<const Eigen::Vector2f> points, const PointPredicate& is_dynamic);
+
+  AntColonyParams params_;
+  SearchResult result_;
+  // Grid buckets in compressed form: points of cell c are cell_points_[cell_start_[c] ..
+  // cell_start_[c + 1]).
+  float cell_size_ = 1.0f;
+  int grid_cols_ = 0;
+  int grid_rows_ = 0;
+  std::vector<int> cell_start_;
+  std::vector<int> cell_points_;
+  std::vector<int> point_cell_;
+  std::vector<int> cell_cursor_;
+  cv::Size path_size_;
+  std::vector<Eigen::Vector2f> path_nodes_;
+  std::vector<Eigen::Vector2f> community_;
+  std::vector<Eigen::Vector2f> hull_;
+  std::vector<Eigen::Vector2f> hull_scratch_;
+  std::vector<int> found_;
+};
+
+}  // namespace pspslam

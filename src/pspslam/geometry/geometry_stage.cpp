@@ -1,0 +1,153 @@
+#include "pspslam/geometry/geometry_stage.h"
+
+#include <chrono>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+GeometryParams GeometryParams::from_yaml(YamlSection& section) {
+  GeometryParams p;
+  YamlSection homography = section.section("homography");
+  p.homography = HomographyParams::from_yaml(homography);
+  YamlSection multiview = section.section("multiview");
+  p.multiview = MultiViewParams::from_yaml(multiview);
+  YamlSection search = section.section("search");
+  p.search = AntColonyParams::from_yaml(search);
+  YamlSection region = section.section("region");
+  p.region = RegionGrowParams::from_yaml(region);
+  p.previous_mask_prior = section.optional("previous_mask_prior", p.previous_mask_prior);
+  section.finish();
+  return p;
+}
+
+GeometryStage::GeometryStage(PinholeCamera camera, GeometryParams params)
+    : camera_(camera),
+      params_(params),
+      test_(camera, params.multiview),
+      search_(params.search),
+      grower_(params.region) {}
+
+GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
+  const auto start = std::chrono::steady_clock::now();
+  if (input.depth.type() != CV_32FC1) throw Error("GeometryStage: depth must be CV_32FC1 metres");
+  if (!input.keypoint_depths.empty() && input.keypoint_depths.size() != input.keypoints.size()) {
+    throw Error("GeometryStage: " + std::to_string(input.keypoint_depths.size()) +
+                " keypoint depths for " + std::to_string(input.keypoints.size()) + " keypoints");
+  }
+  GeometryFrameResult result;
+
+  // III.B: camera-motion compensation of the previous frame (eq. 10-11).
+  if (input.matched_previous.size() >= 4) {
+    result.homography = estimate_compensated_homography(input.matched_previous,
+                                                        input.matched_current, params_.homography);
+    if (result.homography.valid && !input.previous_dynamic_mask.empty()) {
+      result.warped_previous_mask = warp_to_current(
+          input.previous_dynamic_mask, result.homography.H, input.depth.size(), true);
+    }
+  } else if (!input.previous_dynamic_mask.empty() &&
+             input.previous_dynamic_mask.size() == input.depth.size()) {
+    result.warped_previous_mask = input.previous_dynamic_mask;  // no motion estimate: identity
+  }
+  result.timing.homography_ms = milliseconds_since(start);
+
+  // Candidates with their depths.
+  const size_t n = input.keypoints.size();
+  points_.resize(n);
+  candidates_.resize(n);
+  priority_.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& pixel = input.keypoints[i];
+    points_[i] = pixel.cast<float>();
+    double depth = 0.0;
+    if (!input.keypoint_depths.empty()) {
+      depth = input.keypoint_depths[i];
+    } else {
+      const int u = static_cast<int>(std::lround(pixel.x()));
+      const int v = static_cast<int>(std::lround(pixel.y()));
+      if (u >= 0 && v >= 0 && u < input.depth.cols && v < input.depth.rows)
+        depth = input.depth.at<float>(v, u);
+    }
+    candidates_[i] = {pixel, depth};
+    if (params_.previous_mask_prior && !result.warped_previous_mask.empty()) {
+      const int u = static_cast<int>(pixel.x()), v = static_cast<int>(pixel.y());
+      if (u >= 0 && v >= 0 && u < result.warped_previous_mask.cols &&
+          v < result.warped_previous_mask.rows && result.warped_previous_mask.at<std::uint8_t>(v, u))
+        priority_.push_back(static_cast<int>(i));
+    }
+  }
+
+  // III.C: reverse ant-colony search driving the multi-view test.
+  const auto search_start = std::chrono::steady_clock::now();
+  test_.set_frame(input.T_world_camera, input.references);
+  const SearchResult& search = search_.run(
+      points_, input.depth.size(),
+      [this](int index) { return test_.is_dynamic(candidates_[index]); }, priority_);
+  result.timing.search_ms = milliseconds_since(search_start);
+
+  // Region growing from the dynamic points; verified-static points may act as barriers.
+  const auto region_start = std::chrono::steady_clock::now();
+  seeds_.clear();
+  seed_depths_.clear();
+  static_points_.clear();
+  for (size_t i = 0; i < n; ++i) {
+    if (search.dynamic[i]) {
+      seeds_.push_back(points_[i]);
+      seed_depths_.push_back(static_cast<float>(candidates_[i].depth));
+    } else if (search.tested[i]) {
+      static_points_.push_back(points_[i]);
+    }
+  }
+  grower_.grow(input.depth, seeds_, seed_depths_, static_points_, result.dynamic_mask);
+  result.timing.region_ms = milliseconds_since(region_start);
+
+  result.keypoint_tested = search.tested;
+  result.keypoint_tested_dynamic = search.dynamic;
+  result.keypoint_dynamic.assign(n, 0);
+  result.tested_count = search.tested_count;
+  result.tested_dynamic_count = search.dynamic_count;
+  for (size_t i = 0; i < n; ++i) {
+    const int u = static_cast<int>(points_[i].x()), v = static_cast<int>(points_[i].y());
+    const bool in_mask = u >= 0 && v >= 0 && u < result.dynamic_mask.cols &&
+                         v < result.dynamic_mask.rows && result.dynamic_mask.at<std::uint8_t>(v, u);
+    result.keypoint_dynamic[i] = search.dynamic[i] || in_mask;
+    result.dynamic_count += result.keypoint_dynamic[i];
+  }
+  result.timing.total_ms = milliseconds_since(start);
+  return result;
+}
+
+cv::Mat fuse_dynamic_masks(const cv::Mat& semantic_mask, const cv::Mat& geometry_mask,
+                           int dilation_px) {
+  if (semantic_mask.empty() && geometry_mask.empty()) return {};
+  const cv::Size size = semantic_mask.empty() ? geometry_mask.size() : semantic_mask.size();
+  if (!semantic_mask.empty() && !geometry_mask.empty() && semantic_mask.size() != geometry_mask.size()) {
+    throw Error("fuse_dynamic_masks: semantic mask " + std::to_string(semantic_mask.cols) + "x" +
+                std::to_string(semantic_mask.rows) + " and geometry mask " +
+                std::to_string(geometry_mask.cols) + "x" + std::to_string(geometry_mask.rows) +
+                " differ in size");
+  }
+  cv::Mat fused = cv::Mat::zeros(size, CV_8UC1);
+  for (const cv::Mat* mask : {&semantic_mask, &geometry_mask}) {
+    if (mask->empty()) continue;
+    if (mask->type() != CV_8UC1) throw Error("fuse_dynamic_masks: masks must be CV_8UC1");
+    fused.setTo(255, *mask);
+  }
+  if (dilation_px > 0) {
+    const int k = 2 * dilation_px + 1;
+    cv::dilate(fused, fused, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+  }
+  return fused;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,101 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <span>
+#include <vector>
+
+#include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/core/types.h"
+#include "pspslam/geometry/ant_colony_search.h"
+#include "pspslam/geometry/compensated_homography.h"
+#include "pspslam/geometry/multiview_test.h"
+#include "pspslam/geometry/region_growing.h"
+
+namespace pspslam {
+
+class YamlSection;
+
+// All parameters of the geometry thread (paper III.B/C). YAML section `geometry:` with the
+// sub-sections homography, multiview, search, region; every key is optional.
+struct GeometryParams {
+  HomographyParams homography;
+  MultiViewParams multiview;
+  AntColonyParams search;
+  RegionGrowParams region;
+  // Test the points inside the previous frame's dynamic mask (warped into this frame by the
+  // compensated homography) before walking the path.
+  bool previous_mask_prior = true;
+
+  static GeometryParams from_yaml(YamlSection& section);
+};
+
+// One frame's input. Spans and cv::Mat headers refer to caller-owned data for the duration of
+// GeometryStage::process() only.
+struct GeometryFrameInput {
+  cv::Mat depth;                         // current depth, CV_32FC1 metres
+  Pose T_world_camera = Pose::Identity();  // current pose estimate
+  std::span<const Eigen::Vector2d> keypoints;  // candidate pixels (undistorted)
+  // Measured depth per keypoint (metres); empty = read from `depth` at the rounded pixel.
+  std::span<const float> keypoint_depths;
+  std::span<const DepthView> references;  // up to MultiViewParams::max_reference_views
+  // Matches previous -> current for the compensated homography; fewer than 4 skips it.
+  std::span<const Eigen::Vector2d> matched_previous;
+  std::span<const Eigen::Vector2d> matched_current;
+  cv::Mat previous_dynamic_mask;  // optional CV_8UC1 (non-zero = dynamic) of the previous frame
+};
+
+struct GeometryTiming {
+  double homography_ms = 0.0;
+  double search_ms = 0.0;  // ant-colony (or exhaustive) search including the multi-view tests
+  double region_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+struct GeometryFrameResult {
+  cv::Mat dynamic_mask;  // CV_8UC1, 255 = dynamic (grown regions, dilated)
+  // Per keypoint: dynamic = found dynamic by the test or inside the grown mask.
+  std::vector<std::uint8_t> keypoint_dynamic;
+  std::vector<std::uint8_t> keypoint_tested;
+  std::vector<std::uint8_t> keypoint_tested_dynamic;
+  int tested_count = 0;
+  int tested_dynamic_count = 0;
+  int dynamic_count = 0;
+  CompensatedHomography homography;  // valid = false when no matches were given
+  cv::Mat warped_previous_mask;      // previous mask in the motion-compensated frame (if given)
+  GeometryTiming timing;
+};
+
+// The per-frame geometry stage: compensated homography (eq. 10-11) -> search (Fig. 6) with the
+// multi-view test -> region growing. It owns reusable buffers and no globals: create one per
+// worker thread and call process() from that thread only; results are returned by value so they
+// can be handed to another thread.
+class GeometryStage {
+ public:
+  GeometryStage(PinholeCamera camera, GeometryParams params);
+
+  GeometryFrameResult process(const GeometryFrameInput& input);
+
+  const GeometryParams& params() const { return params_; }
+
+ private:
+  PinholeCamera camera_;
+  GeometryParams params_;
+  MultiViewTest test_;
+  DynamicPointSearch search_;
+  DynamicRegionGrower grower_;
+  std::vector<Eigen::Vector2f> points_;
+  std::vector<CandidatePoint> candidates_;
+  std::vector<int> priority_;
+  std::vector<Eigen::Vector2f> seeds_;
+  std::vector<float> seed_depths_;
+  std::vector<Eigen::Vector2f> static_points_;
+};
+
+// Per-frame dynamic mask fusing the semantic thread's mask and the geometry mask: OR of both
+// (non-zero = dynamic), dilated by `dilation_px` to cover object borders. Either may be empty.
+cv::Mat fuse_dynamic_masks(const cv::Mat& semantic_mask, const cv::Mat& geometry_mask,
+                           int dilation_px);
+
+}  // namespace pspslam

@@ -1,0 +1,136 @@
+#include "pspslam/geometry/multiview_test.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+namespace {
+
+void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
+  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+}
+
+}  // namespace
+
+MultiViewParams MultiViewParams::from_yaml(YamlSection& section) {
+  MultiViewParams p;
+  p.depth_threshold_abs_m = section.optional("depth_threshold_abs_m", p.depth_threshold_abs_m);
+  require(p.depth_threshold_abs_m >= 0.0, section, "depth_threshold_abs_m", "must be >= 0");
+  p.depth_threshold_relative =
+      section.optional("depth_threshold_relative", p.depth_threshold_relative);
+  require(p.depth_threshold_relative >= 0.0, section, "depth_threshold_relative", "must be >= 0");
+  require(p.depth_threshold_abs_m + p.depth_threshold_relative > 0.0, section,
+          "depth_threshold_relative", "and depth_threshold_abs_m cannot both be 0");
+  const std::string disagreement = section.optional<std::string>("disagreement", "farther_only");
+  if (disagreement == "farther_only") {
+    p.disagreement = DepthDisagreement::farther_only;
+  } else if (disagreement == "either_sign") {
+    p.disagreement = DepthDisagreement::either_sign;
+  } else {
+    throw Error(section.file() + ": key '" + section.qualified("disagreement") +
+                "' must be farther_only or either_sign, not '" + disagreement + "'");
+  }
+  p.max_parallax_deg = section.optional("max_parallax_deg", p.max_parallax_deg);
+  require(p.max_parallax_deg > 0.0 && p.max_parallax_deg <= 180.0, section, "max_parallax_deg",
+          "must be in (0, 180]");
+  p.reference_patch_radius = section.optional("reference_patch_radius", p.reference_patch_radius);
+  require(p.reference_patch_radius >= 0 && p.reference_patch_radius <= 10, section,
+          "reference_patch_radius", "must be in [0, 10]");
+  p.min_dynamic_vote_fraction =
+      section.optional("min_dynamic_vote_fraction", p.min_dynamic_vote_fraction);
+  require(p.min_dynamic_vote_fraction > 0.0 && p.min_dynamic_vote_fraction <= 1.0, section,
+          "min_dynamic_vote_fraction", "must be in (0, 1]");
+  p.max_reference_views = section.optional("max_reference_views", p.max_reference_views);
+  require(p.max_reference_views >= 1, section, "max_reference_views", "must be >= 1");
+  p.min_depth_m = section.optional("min_depth_m", p.min_depth_m);
+  require(p.min_depth_m > 0.0, section, "min_depth_m", "must be > 0");
+  p.max_depth_m = section.optional("max_depth_m", p.max_depth_m);
+  require(p.max_depth_m > p.min_depth_m, section, "max_depth_m", "must be > min_depth_m");
+  section.finish();
+  return p;
+}
+
+MultiViewTest::MultiViewTest(PinholeCamera camera, MultiViewParams params)
+    : camera_(camera), params_(params) {
+  cos_max_parallax_ = std::cos(params_.max_parallax_deg * M_PI / 180.0);
+}
+
+void MultiViewTest::set_frame(const Pose& T_world_current, std::span<const DepthView> references) {
+  references_.clear();
+  const size_t count = std::min(references.size(), static_cast<size_t>(params_.max_reference_views));
+  for (size_t i = 0; i < count; ++i) {
+    const DepthView& view = references[i];
+    if (view.depth.empty()) continue;
+    if (view.depth.type() != CV_32FC1) {
+      throw Error("MultiViewTest: reference depth must be CV_32FC1 metres");
+    }
+    const Pose T_ref_current = view.T_world_camera.inverse() * T_world_current;
+    const Pose T_current_ref = T_ref_current.inverse();
+    references_.push_back({T_ref_current.linear(), T_ref_current.translation(),
+                           T_current_ref.translation(), view.depth});
+  }
+}
+
+MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
+  MultiViewVerdict verdict;
+  if (!(point.depth >= params_.min_depth_m && point.depth <= params_.max_depth_m)) return verdict;
+  const Eigen::Vector3d p_current = camera_.unproject(point.pixel, point.depth);
+  const double current_ray_norm = p_current.norm();
+  const int r = params_.reference_patch_radius;
+  for (const Reference& ref : references_) {
+    const Eigen::Vector3d p_ref = ref.R_ref_current * p_current + ref.t_ref_current;
+    const double projected_depth = p_ref.z();
+    if (projected_depth < params_.min_depth_m || projected_depth > params_.max_depth_m) continue;
+    const Eigen::Vector2d pixel = camera_.project(p_ref);
+    const int u = static_cast<int>(std::lround(pixel.x()));
+    const int v = static_cast<int>(std::lround(pixel.y()));
+    if (u < r || v < r || u >= ref.depth.cols - r || v >= ref.depth.rows - r) continue;
+    // Parallax: angle at the point between the rays to the two camera centres.
+    const Eigen::Vector3d ray_ref = p_current - ref.center_in_current;
+    const double cos_parallax = p_current.dot(ray_ref) / (current_ray_norm * ray_ref.norm());
+    if (cos_parallax < cos_max_parallax_) continue;
+    const double threshold =
+        params_.depth_threshold_abs_m + params_.depth_threshold_relative * projected_depth;
+    // The reference agrees when any valid pixel of the patch is consistent with the point.
+    int valid_pixels = 0;
+    bool consistent = false;
+    for (int dv = -r; dv <= r && !consistent; ++dv) {
+      const float* row = ref.depth.ptr<float>(v + dv);
+      for (int du = -r; du <= r; ++du) {
+        const double measured = row[u + du];
+        if (!(measured > 0.0)) continue;
+        ++valid_pixels;
+        const double difference = measured - projected_depth;
+        const bool disagrees = params_.disagreement == DepthDisagreement::farther_only
+                                   ? difference > threshold
+                                   : std::abs(difference) > threshold;
+        if (!disagrees) {
+          consistent = true;
+          break;
+        }
+      }
+    }
+    if (valid_pixels == 0) continue;
+    ++verdict.valid_references;
+    if (!consistent) ++verdict.dynamic_votes;
+    // With "any" (fraction reached by one vote) the first dynamic vote decides: no need to
+    // look at the remaining references.
+    if (verdict.dynamic_votes >= 1 &&
+        params_.min_dynamic_vote_fraction * (verdict.valid_references) <= 1.0 &&
+        params_.min_dynamic_vote_fraction * static_cast<double>(references_.size()) <= 1.0)
+      break;
+  }
+  if (verdict.valid_references > 0) {
+    const int needed = std::max(
+        1, static_cast<int>(std::ceil(params_.min_dynamic_vote_fraction * verdict.valid_references -
+                                      1e-9)));
+    verdict.dynamic = verdict.dynamic_votes >= needed;
+  }
+  return verdict;
+}
+
+}  // namespace pspslam

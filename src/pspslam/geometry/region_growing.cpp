@@ -1,0 +1,168 @@
+#include "pspslam/geometry/region_growing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+namespace {
+
+void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
+  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+}
+
+}  // namespace
+
+RegionGrowParams RegionGrowParams::from_yaml(YamlSection& section) {
+  RegionGrowParams p;
+  p.enabled = section.optional("enabled", p.enabled);
+  p.stride = section.optional("stride", p.stride);
+  require(p.stride >= 1 && p.stride <= 16, section, "stride", "must be in [1, 16]");
+  p.max_step_abs_m = section.optional("max_step_abs_m", p.max_step_abs_m);
+  require(p.max_step_abs_m >= 0.0, section, "max_step_abs_m", "must be >= 0");
+  p.max_step_relative = section.optional("max_step_relative", p.max_step_relative);
+  require(p.max_step_relative >= 0.0, section, "max_step_relative", "must be >= 0");
+  p.max_depth_from_seed_m = section.optional("max_depth_from_seed_m", p.max_depth_from_seed_m);
+  require(p.max_depth_from_seed_m > 0.0, section, "max_depth_from_seed_m", "must be > 0");
+  p.max_grow_radius_px = section.optional("max_grow_radius_px", p.max_grow_radius_px);
+  require(p.max_grow_radius_px > 0.0f, section, "max_grow_radius_px", "must be > 0");
+  p.min_seeds_per_region = section.optional("min_seeds_per_region", p.min_seeds_per_region);
+  require(p.min_seeds_per_region >= 1, section, "min_seeds_per_region", "must be >= 1");
+  p.max_region_samples = section.optional("max_region_samples", p.max_region_samples);
+  require(p.max_region_samples >= 1, section, "max_region_samples", "must be >= 1");
+  p.static_barrier_radius_px =
+      section.optional("static_barrier_radius_px", p.static_barrier_radius_px);
+  require(p.static_barrier_radius_px >= 0.0f, section, "static_barrier_radius_px", "must be >= 0");
+  p.dilation_px = section.optional("dilation_px", p.dilation_px);
+  require(p.dilation_px >= 0, section, "dilation_px", "must be >= 0");
+  section.finish();
+  return p;
+}
+
+DynamicRegionGrower::DynamicRegionGrower(RegionGrowParams params) : params_(params) {}
+
+void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vector2f> seeds,
+                               std::span<const float> seed_depths,
+                               std::span<const Eigen::Vector2f> static_points, cv::Mat& mask) {
+  if (depth.type() != CV_32FC1) throw Error("DynamicRegionGrower: depth must be CV_32FC1 metres");
+  if (seed_depths.size() != seeds.size()) {
+    throw Error("DynamicRegionGrower: " + std::to_string(seed_depths.size()) + " seed depths for " +
+                std::to_string(seeds.size()) + " seeds");
+  }
+  mask.create(depth.size(), CV_8UC1);
+  mask.setTo(0);
+  if (!params_.enabled || seeds.empty()) return;
+  const int s = params_.stride;
+  const int cols = (depth.cols + s - 1) / s;
+  const int rows = (depth.rows + s - 1) / s;
+  // Nearest sampling (block centre) keeps depth edges sharp, unlike area averaging.
+  grid_depth_.create(rows, cols, CV_32FC1);
+  for (int gy = 0; gy < rows; ++gy) {
+    const float* src = depth.ptr<float>(std::min(gy * s + s / 2, depth.rows - 1));
+    float* dst = grid_depth_.ptr<float>(gy);
+    for (int gx = 0; gx < cols; ++gx) dst[gx] = src[std::min(gx * s + s / 2, depth.cols - 1)];
+  }
+  const size_t cells = static_cast<size_t>(rows) * cols;
+  region_of_.assign(cells, -1);
+  barrier_.assign(cells, 0);
+  if (params_.static_barrier_radius_px > 0.0f) {
+    const int radius = static_cast<int>(std::ceil(params_.static_barrier_radius_px / s));
+    for (const Eigen::Vector2f& p : static_points) {
+      const int cx = static_cast<int>(p.x()) / s, cy = static_cast<int>(p.y()) / s;
+      for (int y = std::max(0, cy - radius); y <= std::min(rows - 1, cy + radius); ++y)
+        for (int x = std::max(0, cx - radius); x <= std::min(cols - 1, cx + radius); ++x)
+          barrier_[static_cast<size_t>(y) * cols + x] = 1;
+    }
+  }
+
+  constexpr int kOffsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  const float radius_cells = params_.max_grow_radius_px / static_cast<float>(s);
+  const float radius2 = radius_cells * radius_cells;
+  region_seeds_.clear();
+  for (size_t seed_index = 0; seed_index < seeds.size(); ++seed_index) {
+    const Eigen::Vector2f& seed = seeds[seed_index];
+    const float wanted = seed_depths[seed_index];
+    const double tolerance = params_.max_step_abs_m + params_.max_step_relative * wanted;
+    // Start on the 3x3 grid neighbour whose depth is closest to the seed's own depth: next to
+    // an object edge the block sample may lie on the background.
+    const int cx = std::clamp(static_cast<int>(seed.x()) / s, 0, cols - 1);
+    const int cy = std::clamp(static_cast<int>(seed.y()) / s, 0, rows - 1);
+    int sx = -1, sy = -1;
+    float best = std::numeric_limits<float>::infinity();
+    for (int y = std::max(0, cy - 1); y <= std::min(rows - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(cols - 1, cx + 1); ++x) {
+        const float gap = std::abs(grid_depth_.at<float>(y, x) - wanted);
+        if (grid_depth_.at<float>(y, x) > 0.0f && gap < best) {
+          best = gap;
+          sx = x;
+          sy = y;
+        }
+      }
+    }
+    if (sx < 0 || best > tolerance) continue;
+    const size_t start = static_cast<size_t>(sy) * cols + sx;
+    if (region_of_[start] >= 0) {  // inside an earlier seed's region: one more vote for it
+      ++region_seeds_[region_of_[start]];
+      continue;
+    }
+    const float seed_depth = grid_depth_.at<float>(sy, sx);
+    const int region_id = static_cast<int>(region_seeds_.size());
+    region_seeds_.push_back(1);
+    region_of_[start] = region_id;
+    queue_.assign(1, static_cast<int>(start));
+    size_t head = 0;
+    while (head < queue_.size() && static_cast<int>(queue_.size()) < params_.max_region_samples) {
+      const int cell = queue_[head++];
+      const int x = cell % cols, y = cell / cols;
+      const float d = grid_depth_.at<float>(y, x);
+      const double step = params_.max_step_abs_m + params_.max_step_relative * d;
+      for (const auto& offset : kOffsets) {
+        const int nx = x + offset[0], ny = y + offset[1];
+        if (nx < 0 || ny < 0 || nx >= cols || ny >= rows) continue;
+        const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
+        if (dx * dx + dy * dy > radius2) continue;
+        const size_t next = static_cast<size_t>(ny) * cols + nx;
+        if (region_of_[next] >= 0 || barrier_[next]) continue;
+        const float nd = grid_depth_.at<float>(ny, nx);
+        if (!(nd > 0.0f) || std::abs(nd - d) > step ||
+            std::abs(nd - seed_depth) > params_.max_depth_from_seed_m)
+          continue;
+        region_of_[next] = region_id;
+        queue_.push_back(static_cast<int>(next));
+      }
+    }
+  }
+  // Regions that too few seeds support are dropped before painting.
+  for (int& region : region_of_) {
+    if (region >= 0 && region_seeds_[region] < params_.min_seeds_per_region) region = -1;
+  }
+  // Full-resolution fill: a pixel of a grown block joins only if its own depth is continuous with
+  // the block's sample, so silhouettes stay pixel-sharp although growth ran on the coarse grid.
+  for (int y = 0; y < depth.rows; ++y) {
+    const int gy = y / s;
+    const int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
+    const float* samples = grid_depth_.ptr<float>(gy);
+    const float* row = depth.ptr<float>(y);
+    std::uint8_t* out = mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < depth.cols; ++x) {
+      const int gx = x / s;
+      if (regions[gx] < 0) {
+        out[x] = 0;
+        continue;
+      }
+      const float sample = samples[gx];
+      const double step = params_.max_step_abs_m + params_.max_step_relative * sample;
+      out[x] = row[x] > 0.0f && std::abs(row[x] - sample) <= step ? 255 : 0;
+    }
+  }
+  if (params_.dilation_px > 0) {
+    const int k = 2 * params_.dilation_px + 1;
+    cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+  }
+}
+
+}  // namespace pspslam

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <span>
+#include <vector>
+
+namespace pspslam {
+
+class YamlSection;
+
+// Growing dynamic keypoints into dynamic regions on the current depth image (paper III.C: whole
+// objects, including an object a person carries, are masked, not only their keypoints).
+struct RegionGrowParams {
+  bool enabled = true;
+  // Growth runs on a grid of one depth sample per stride x stride block (speed; the mask is then
+  // filled block-wise at full resolution).
+  int stride = 2;
+  // Neighbouring samples belong to the same surface when their depths differ by at most
+  // abs + relative * depth (depth continuity).
+  double max_step_abs_m = 0.03;
+  double max_step_relative = 0.02;
+  // A region stays within this distance in depth of the seed that started it: stops the classic
+  // leak from a person's feet along the floor.
+  double max_depth_from_seed_m = 0.6;
+  // Bounded growth: a seed only claims samples within this image distance of itself. A wrong
+  // seed on a wall then marks a small disc, not the wall; a person is covered by many seeds.
+  float max_grow_radius_px = 40.0f;
+  // A grown region is kept only when at least this many dynamic seeds fall inside it, so one
+  // isolated false detection does not mask anything beyond its own keypoint.
+  int min_seeds_per_region = 2;
+  // Safety bound on samples per seed region.
+  int max_region_samples = 40000;
+  // Grid samples within this radius (pixels) of a point verified static are barriers.
+  float static_barrier_radius_px = 0.0f;
+  // Final dilation of the mask (pixels) to cover the depth edge around objects.
+  int dilation_px = 2;
+
+  static RegionGrowParams from_yaml(YamlSection& section);
+};
+
+// Reusable grower (buffers kept between frames). Not thread-safe; one per worker thread.
+class DynamicRegionGrower {
+ public:
+  explicit DynamicRegionGrower(RegionGrowParams params = {});
+
+  // Writes `mask` (CV_8UC1, depth's size, 255 = dynamic). Seeds are pixels of dynamic points
+  // with their measured depths (a seed starts at a grid sample on its own surface, never on the
+  // background just beside an object edge); `static_points` are pixels of points verified static
+  // (barriers when the radius is > 0).
+  void grow(const cv::Mat& depth, std::span<const Eigen::Vector2f> seeds,
+            std::span<const float> seed_depths, std::span<const Eigen::Vector2f> static_points,
+            cv::Mat& mask);
+
+  const RegionGrowParams& params() const { return params_; }
+
+ private:
+  RegionGrowParams params_;
+  cv::Mat grid_depth_;            // CV_32F, one sample per block
+  std::vector<int> region_of_;    // -1 = not visited; otherwise seed region id
+  std::vector<int> region_seeds_;  // dynamic seeds that fell inside each region
+  std::vector<std::uint8_t> barrier_;
+  std::vector<int> queue_;
+};
+
+}  // namespace pspslam

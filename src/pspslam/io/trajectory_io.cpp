@@ -1,0 +1,102 @@
+#include "pspslam/io/trajectory_io.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <unordered_map>
+
+#include "pspslam/core/error.h"
+#include "pspslam/io/text_lines.h"
+
+namespace pspslam {
+namespace {
+
+constexpr const char* kFieldNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+
+std::string format_number(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+}  // namespace
+
+Trajectory read_tum_trajectory(const std::filesystem::path& file) {
+  Trajectory trajectory;
+  std::unordered_map<double, size_t> line_of_timestamp;
+  for_each_data_line(file, "trajectory file", [&](const TextLine& line) {
+    if (line.fields.size() != 8) {
+      throw Error(line_prefix(file, line.line) +
+                  "expected 8 fields 'timestamp tx ty tz qx qy qz qw', got " +
+                  std::to_string(line.fields.size()));
+    }
+    double values[8];
+    for (size_t i = 0; i < 8; ++i) {
+      values[i] = parse_number(line.fields[i], file, line.line, kFieldNames[i]);
+    }
+    Eigen::Quaterniond q(values[7], values[4], values[5], values[6]);
+    const double norm = q.norm();
+    if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+      throw Error(line_prefix(file, line.line) + "quaternion (qx qy qz qw) has norm " +
+                  format_number(norm, 6) + ", expected a unit quaternion");
+    }
+    const auto [it, inserted] = line_of_timestamp.emplace(values[0], line.line);
+    if (!inserted) {
+      throw Error(line_prefix(file, line.line) + "timestamp " + std::string(line.fields[0]) +
+                  " repeats line " + std::to_string(it->second));
+    }
+    StampedPose pose;
+    pose.timestamp = values[0];
+    pose.T_world_camera.linear() = q.normalized().toRotationMatrix();
+    pose.T_world_camera.translation() = Eigen::Vector3d(values[1], values[2], values[3]);
+    trajectory.push_back(pose);
+  });
+  return trajectory;
+}
+
+std::string format_tum_pose(const StampedPose& pose) {
+  const Eigen::Vector3d t = pose.T_world_camera.translation();
+  const Eigen::Quaterniond q(pose.T_world_camera.rotation());
+  // Shortest text that parses back to the same double: exact round trip, and input timestamps
+  // such as 1548339819.87426 are written exactly as the dataset lists them.
+  char buffer[64];
+  std::string line;
+  line.reserve(160);
+  auto append = [&](double value, std::chars_format format) {
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value, format);
+    line.append(buffer, result.ptr);
+  };
+  append(pose.timestamp, std::chars_format::fixed);
+  for (const double v : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) {
+    line += ' ';
+    append(v, std::chars_format::general);
+  }
+  return line;
+}
+
+void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory) {
+  TrajectoryWriter writer(file);
+  for (const StampedPose& pose : trajectory) writer.write(pose);
+}
+
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file) : path_(file) {
+  if (file.has_parent_path()) {
+    std::error_code ignored;
+    std::filesystem::create_directories(file.parent_path(), ignored);
+  }
+  stream_.open(file, std::ios::out | std::ios::trunc);
+  if (!stream_) throw Error(file.string() + ": cannot write trajectory file");
+  stream_ << kTrajectoryHeader << '\n';
+  stream_.flush();
+}
+
+void TrajectoryWriter::write(const StampedPose& pose) {
+  // One complete line per write + flush: a kill between two writes leaves only whole lines.
+  const std::string line = format_tum_pose(pose) + '\n';
+  stream_.write(line.data(), static_cast<std::streamsize>(line.size()));
+  stream_.flush();
+  if (!stream_) throw Error(path_.string() + ": cannot write trajectory file (disk full?)");
+  ++count_;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "pspslam/core/types.h"
+
+namespace pspslam {
+
+// Largest accepted | |q| - 1 | of a quaternion read from a file. TUM files print 4-6 significant
+// digits, so the norm of a valid quaternion can be off by ~1e-5; anything beyond 1e-3 is a
+// corrupt or mis-ordered line, not rounding.
+inline constexpr double kQuaternionNormTolerance = 1e-3;
+
+// Reads a TUM trajectory: one pose per line, `timestamp tx ty tz qx qy qz qw` (camera-to-world),
+// `#` comments and blank lines ignored, fields separated by spaces, tabs or commas.
+// Quaternions are normalised after the tolerance check. Poses are returned in file order.
+// Errors (pspslam::Error): "<file>: cannot open trajectory file", and per line
+// "<file>:<line>: expected 8 fields ..., got N", "... '<text>' is not a number",
+// "... quaternion ... has norm X, expected a unit quaternion", "... timestamp ... repeats line N".
+Trajectory read_tum_trajectory(const std::filesystem::path& file);
+
+// One TUM line (no newline); every number in its shortest exact form, so reading the line back
+// gives the same doubles (timestamps bit-exact; the pose up to the quaternion conversion).
+std::string format_tum_pose(const StampedPose& pose);
+
+// The comment written at the top of every trajectory file.
+inline constexpr const char* kTrajectoryHeader =
+    "# pspslam trajectory: T_world_camera (camera-to-world), TUM format: timestamp tx ty tz qx qy "
+    "qz qw";
+
+// Writes a whole trajectory at once (header + one line per pose).
+void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory);
+
+// Writes poses one at a time as they are computed. Every write() reaches the operating system
+// before it returns (flush), so if the process is interrupted or killed the file still holds a
+// valid trajectory with every pose written so far (a run's partial result stays evaluable).
+class TrajectoryWriter {
+ public:
+  // Creates/truncates `file` (parent directories are created) and writes the header.
+  explicit TrajectoryWriter(const std::filesystem::path& file);
+
+  void write(const StampedPose& pose);
+  void write(Timestamp timestamp, const Pose& T_world_camera) { write({timestamp, T_world_camera}); }
+
+  size_t count() const { return count_; }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  std::ofstream stream_;
+  size_t count_ = 0;
+};
+
+}  // namespace pspslam

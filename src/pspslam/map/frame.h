@@ -1,0 +1,83 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "pspslam/core/types.h"
+#include "pspslam/map/feature_grid.h"
+#include "pspslam/map/rgbd_camera.h"
+#include "pspslam/map/scale_pyramid.h"
+
+namespace pspslam {
+
+class MapPoint;
+
+// One tracked image: undistorted keypoints with their depth, descriptors and the map points
+// that tracking associates with them. A Frame is transient and owned by tracking; it shares
+// ownership of the map points it currently uses (they never point back to a Frame).
+class Frame {
+ public:
+  // `keypoints` are in distorted image coordinates as the extractor returns them; depth is
+  // read there (the depth image is registered to the distorted colour image), then the
+  // keypoints are undistorted once. `descriptors`: N x 32 CV_8U (shared, not copied).
+  Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
+        cv::Mat descriptors, const cv::Mat& depth_metres,
+        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid);
+
+  std::uint64_t id() const { return id_; }
+  Timestamp timestamp() const { return timestamp_; }
+  int size() const { return static_cast<int>(keypoints_.size()); }
+
+  const std::vector<cv::KeyPoint>& keypoints() const { return keypoints_; }
+  const cv::Mat& descriptors() const { return descriptors_; }
+  const std::uint8_t* descriptor(int i) const { return descriptors_.ptr<std::uint8_t>(i); }
+  // Depth in metres (<= 0: no valid reading) and virtual right coordinate (< 0: none).
+  float depth(int i) const { return depth_[i]; }
+  float right_u(int i) const { return right_u_[i]; }
+  const std::vector<float>& depths() const { return depth_; }
+  const std::vector<float>& right_us() const { return right_u_; }
+  const RgbdCamera& camera() const { return *camera_; }
+  const ScalePyramid& pyramid() const { return *pyramid_; }
+  const std::shared_ptr<const RgbdCamera>& camera_ptr() const { return camera_; }
+  const std::shared_ptr<const ScalePyramid>& pyramid_ptr() const { return pyramid_; }
+  const FeatureGrid& grid() const { return grid_; }
+
+  // Keypoints within `radius` of (x, y) with octave in [min_level, max_level] (<0: any).
+  void features_in_area(double x, double y, double radius, int min_level, int max_level,
+                        std::vector<int>& out) const {
+    grid_.query(keypoints_, x, y, radius, min_level, max_level, out);
+  }
+
+  // Pose (unset until tracking estimates it; lost frames never get one).
+  bool has_pose() const { return T_camera_world_.has_value(); }
+  void set_pose(const Pose& T_camera_world);
+  void clear_pose() { T_camera_world_.reset(); }
+  const Pose& T_camera_world() const { return *T_camera_world_; }
+  Pose T_world_camera() const { return T_camera_world_->inverse(); }
+  Eigen::Vector3d camera_center() const { return T_camera_world_->inverse().translation(); }
+
+  // Back-projects keypoint i with its depth into camera / world coordinates (needs depth > 0).
+  Eigen::Vector3d unproject_camera(int i) const;
+  Eigen::Vector3d unproject_world(int i) const;
+
+  // Association of keypoint i with a map point (nullptr: none) and its outlier flag.
+  std::vector<std::shared_ptr<MapPoint>> map_points;
+  std::vector<std::uint8_t> outlier;
+
+ private:
+  std::uint64_t id_;
+  Timestamp timestamp_;
+  std::vector<cv::KeyPoint> keypoints_;
+  cv::Mat descriptors_;
+  std::vector<float> depth_;
+  std::vector<float> right_u_;
+  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const ScalePyramid> pyramid_;
+  FeatureGrid grid_;
+  std::optional<Pose> T_camera_world_;
+};
+
+}  // namespace pspslam

@@ -1,0 +1,28 @@
+#include "pspslam/map/rgbd_camera.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace pspslam {
+
+RgbdCamera RgbdCamera::from_config(const CameraConfig& camera, double virtual_baseline) {
+  RgbdCamera c;
+  c.pinhole = camera.pinhole;
+  c.bf = camera.pinhole.fx * virtual_baseline;
+  c.depth_threshold = camera.depth_threshold;
+  const double w = camera.pinhole.width;
+  const double h = camera.pinhole.height;
+  std::vector<cv::Point2f> corners = {{0.0f, 0.0f},
+                                      {static_cast<float>(w), 0.0f},
+                                      {0.0f, static_cast<float>(h)},
+                                      {static_cast<float>(w), static_cast<float>(h)}};
+  camera.pinhole.undistort_points(corners);
+  // Same box as ORB-SLAM2: the widest extent of the undistorted corners.
+  c.min_x = std::min(corners[0].x, corners[2].x);
+  c.max_x = std::max(corners[1].x, corners[3].x);
+  c.min_y = std::min(corners[0].y, corners[1].y);
+  c.max_y = std::max(corners[2].y, corners[3].y);
+  return c;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,35 @@
+#pragma once
+
+#include "pspslam/optimize/local_bundle_adjustment.h"
+
+namespace pspslam {
+
+// Local mapping parameters; defaults are ORB-SLAM2's values for RGB-D input.
+struct LocalMappingOptions {
+  // New points by triangulation against the best covisible keyframes.
+  int triangulation_neighbours = 10;
+  // Keypoints with depth closer than this (metres; the camera's depth_threshold) are "close":
+  // they become map points directly from their depth, and only they count in keyframe culling.
+  double close_depth = 4.0;
+  // Fewer close points than this and the nearest far ones are promoted too (ORB-SLAM2: 100).
+  int min_depth_points = 100;
+  // Hamming distance of an accepted match (ORB-SLAM2's TH_LOW).
+  int max_descriptor_distance = 50;
+  // Duplicate fusion: first neighbours, and second neighbours per first neighbour.
+  int fusion_neighbours = 10;
+  int fusion_second_neighbours = 5;
+  double fusion_radius = 3.0;  // pixels at level 0, times the level scale
+  // Recent map point culling.
+  double min_found_ratio = 0.25;
+  int min_observations = 3;     // a depth observation counts twice
+  int culling_keyframe_span = 2;  // keyframes after creation before min_observations applies
+  int probation_keyframes = 3;    // after this many keyframes a point is no longer "recent"
+  // Redundant keyframe culling: a keyframe goes when more than this fraction of its close map
+  // points are seen by at least redundant_observers other keyframes at the same or finer scale.
+  double redundant_ratio = 0.9;
+  int redundant_observers = 3;
+  bool cull_keyframes = true;
+  BaOptions bundle_adjustment;
+};
+
+}  // namespace pspslam

@@ -1,0 +1,61 @@
+#pragma once
+
+// Pose-only optimisation (motion-only bundle adjustment) of one RGB-D frame against known map
+// points, ORB-SLAM2 semantics. Called by tracking on every frame, so it must stay cheap: measured
+// ≈ see bench/bench_optimize.cpp.
+//
+// Call pattern (tracking):
+//   std::vector<PoseObservation> observations;           // one per matched map point
+//   observations.push_back({point->position(), keypoint_pixel, right_u_or_negative,
+//                           inverse_level_sigma2});
+//   const PoseOptimizationResult result = optimize_pose(camera, bf, predicted_T_camera_world,
+//                                                       observations);
+//   frame.set_pose(result.T_camera_world);              // result.inlier[i] == 0: drop match i
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/core/types.h"
+
+namespace pspslam {
+
+struct PoseObservation {
+  Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // undistorted keypoint
+  double right_u = -1.0;      // virtual right coordinate u − bf/z; < 0: no depth (2-dof residual)
+  double information = 1.0;   // 1 / σ² of the keypoint's pyramid level (σ² = scale²)
+};
+
+struct PoseOptimizationResult {
+  Pose T_camera_world = Pose::Identity();
+  std::vector<uint8_t> inlier;  // per observation: 1 = χ² below threshold in the final round
+  int num_inliers = 0;
+};
+
+struct PoseOptimizerOptions {
+  int rounds = 4;
+  int iterations_per_round = 10;
+  // Rounds [0, robust_rounds) use the Huber kernel; later rounds are plain least squares on the
+  // inliers (ORB-SLAM2 drops the kernel from the third round on).
+  int robust_rounds = 2;
+  double huber_delta_mono = std::sqrt(5.991);
+  double huber_delta_stereo = std::sqrt(7.815);
+  // χ² thresholds at 95%: 2 dof (u, v) and 3 dof (u, v, u_r).
+  double chi2_mono = 5.991;
+  double chi2_stereo = 7.815;
+  // Fewer inliers than this after a round: stop, the pose is not constrained well enough to
+  // keep refining (the remaining rounds would fit the few survivors).
+  int min_inliers_to_continue = 10;
+};
+
+// Refines initial_T_camera_world. Observations with right_u >= 0 constrain (u, v, u_r) with the
+// virtual stereo baseline bf = fx · b; the others (u, v). Never throws on degenerate input: with
+// no observations it returns the initial pose and num_inliers = 0.
+PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
+                                     const Pose& initial_T_camera_world,
+                                     const std::vector<PoseObservation>& observations,
+                                     const PoseOptimizerOptions& options = {});
+
+}  // namespace pspslam

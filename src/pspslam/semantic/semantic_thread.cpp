@@ -1,0 +1,152 @@
+#include "pspslam/semantic/semantic_thread.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+namespace {
+
+double ms_since(SemanticThread::Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(SemanticThread::Clock::now() - t0).count();
+}
+
+}  // namespace
+
+SemanticThread::SemanticThread(std::unique_ptr<Segmenter> segmenter, const SemanticParams& params)
+    : segmenter_(std::move(segmenter)),
+      dilation_px_(params.mask_dilation_px),
+      queue_size_(static_cast<size_t>(std::max(1, params.queue_size))),
+      history_size_(static_cast<size_t>(std::max(1, params.history))) {
+  if (!segmenter_) throw Error("SemanticThread: no segmenter given");
+  dynamic_ids_ = params.dynamic_classes.empty()
+                     ? segmenter_->default_dynamic_classes()
+                     : class_ids(segmenter_->class_names(), params.dynamic_classes,
+                                 "semantic.dynamic_classes");
+  worker_ = std::thread([this] { run(); });
+}
+
+SemanticThread::~SemanticThread() { stop(); }
+
+void SemanticThread::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && !worker_.joinable()) return;
+    stopping_ = true;
+    stats_.dropped += static_cast<std::int64_t>(pending_.size());
+    if (!pending_.empty()) last_finished_id_ = std::max(last_finished_id_, pending_.back().frame_id);
+    pending_.clear();
+  }
+  work_cv_.notify_all();
+  done_cv_.notify_all();
+  if (worker_.joinable() && worker_.get_id() != std::this_thread::get_id()) worker_.join();
+}
+
+bool SemanticThread::submit(std::int64_t frame_id, Timestamp timestamp, const cv::Mat& bgr) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return false;
+    if (frame_id <= last_submitted_id_) {
+      throw Error("SemanticThread::submit: frame id " + std::to_string(frame_id) +
+                  " is not greater than the previous one (" + std::to_string(last_submitted_id_) +
+                  ")");
+    }
+    last_submitted_id_ = frame_id;
+    ++stats_.submitted;
+    // Latest-frame policy: the producer never waits; the oldest pending frame makes room.
+    while (pending_.size() >= queue_size_) {
+      last_finished_id_ = std::max(last_finished_id_, pending_.front().frame_id);
+      pending_.pop_front();
+      ++stats_.dropped;
+    }
+    pending_.push_back(Pending{frame_id, timestamp, bgr, Clock::now()});
+  }
+  work_cv_.notify_one();
+  done_cv_.notify_all();  // waiters on a dropped frame can give up now
+  return true;
+}
+
+void SemanticThread::run() {
+  for (;;) {
+    Pending job;
+    {
+      std::unique_lock lock(mutex_);
+      work_cv_.wait(lock, [this] { return stopping_ || !pending_.empty(); });
+      if (stopping_) return;
+      job = std::move(pending_.front());
+      pending_.pop_front();
+      busy_ = true;
+    }
+    auto result = std::make_shared<SemanticResult>();
+    result->frame_id = job.frame_id;
+    result->timestamp = job.timestamp;
+    const auto t0 = Clock::now();
+    try {
+      result->labels = segmenter_->segment(job.bgr);
+      result->dynamic_mask = dynamic_mask(result->labels, dynamic_ids_, dilation_px_);
+    } catch (...) {
+      // A failing frame must not kill the thread silently with frames still expected:
+      // publish nothing for it, count it as dropped.
+      std::lock_guard lock(mutex_);
+      busy_ = false;
+      ++stats_.dropped;
+      last_finished_id_ = std::max(last_finished_id_, job.frame_id);
+      done_cv_.notify_all();
+      continue;
+    }
+    result->inference_ms = ms_since(t0);
+    result->latency_ms = ms_since(job.submitted);
+    {
+      std::lock_guard lock(mutex_);
+      history_.push_back(std::move(result));
+      while (history_.size() > history_size_) history_.pop_front();
+      ++stats_.processed;
+      last_finished_id_ = std::max(last_finished_id_, job.frame_id);
+      busy_ = false;
+    }
+    done_cv_.notify_all();
+  }
+}
+
+std::shared_ptr<const SemanticResult> SemanticThread::newest() const {
+  std::lock_guard lock(mutex_);
+  return history_.empty() ? nullptr : history_.back();
+}
+
+std::shared_ptr<const SemanticResult> SemanticThread::find(Timestamp t, double tolerance) const {
+  std::lock_guard lock(mutex_);
+  std::shared_ptr<const SemanticResult> best;
+  double best_diff = tolerance;
+  for (const auto& r : history_) {
+    const double diff = std::abs(r->timestamp - t);
+    if (diff <= best_diff) {
+      best = r;
+      best_diff = diff;
+    }
+  }
+  return best;
+}
+
+std::shared_ptr<const SemanticResult> SemanticThread::wait_for(
+    std::int64_t frame_id, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mutex_);
+  done_cv_.wait_for(lock, timeout, [&] { return stopping_ || last_finished_id_ >= frame_id; });
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+    if ((*it)->frame_id == frame_id) return *it;
+    if ((*it)->frame_id < frame_id) break;
+  }
+  return nullptr;
+}
+
+void SemanticThread::wait_idle() const {
+  std::unique_lock lock(mutex_);
+  done_cv_.wait(lock, [this] { return stopping_ || (pending_.empty() && !busy_); });
+}
+
+SemanticStats SemanticThread::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,502 @@
+#include "pspslam/synth/scene.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "pspslam/core/error.h"
+#include "pspslam/synth/motion.h"
+#include "pspslam/synth/sensor.h"
+#include "pspslam/synth/texture.h"
+
+namespace pspslam {
+namespace {
+
+constexpr double kFps = 30.0;
+constexpr double kFirstTimestamp = 1000000.0;
+constexpr float kStaticTexelsPerMetre = 256.0f;
+constexpr float kBodyTexelsPerMetre = 200.0f;
+constexpr float kNearPlane_m = 0.02f;  // equals the clip plane of the screen rectangles
+constexpr int kRowsPerChunk = 8;
+constexpr int kMaxBodies = 200;  // keeps 1 + box * 6 + face inside 16-bit surface ids
+
+// What a box looks like; its pose is given separately (fixed for furniture, animated for bodies).
+struct BoxSurface {
+  Eigen::Vector3d half_extents;
+  bool seen_from_inside = false;  // the room: we see the far side of its faces
+  uint8_t label = kSynthLabelStatic;
+  std::array<int, 6> face_textures{};  // face = 2 * axis + (positive side ? 1 : 0)
+};
+
+// A box as seen from one camera pose, ready for ray casting pixel rays (x_n, y_n, 1).
+struct FrameBox {
+  const BoxSurface* surface = nullptr;
+  Eigen::Matrix3f R_box_camera;
+  Eigen::Vector3f camera_in_box;
+  Eigen::Vector3f half;
+  std::array<float, 6> face_light{};  // view-independent diffuse term of each face
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // screen rectangle that can contain the box (end exclusive)
+  uint16_t first_surface_id = 0;
+};
+
+struct Furniture {
+  Eigen::Vector3d centre;
+  Eigen::Vector3d half;
+  double yaw = 0.0;
+};
+
+// Furniture along the walls, leaving the middle free for the camera and the walking people.
+const std::vector<Furniture>& furniture_layout() {
+  static const std::vector<Furniture> layout = {
+      {{1.5, 0.25, 0.45}, {0.6, 0.25, 0.45}},            // cabinet
+      {{6.78, 2.0, 0.95}, {0.22, 0.5, 0.95}},            // tall shelf
+      {{4.5, 5.6, 0.38}, {0.7, 0.4, 0.38}},              // desk
+      {{4.2, 5.65, 0.86}, {0.15, 0.15, 0.1}, 0.3},       // box on the desk
+      {{0.4, 3.2, 0.22}, {0.4, 0.9, 0.22}},              // sofa seat
+      {{0.1, 3.2, 0.5}, {0.1, 0.9, 0.5}},                // sofa back
+      {{6.55, 0.45, 0.3}, {0.3, 0.3, 0.3}, 0.2},         // crate
+      {{6.55, 0.45, 0.72}, {0.18, 0.18, 0.12}, -0.3},    // small crate on it
+      {{0.3, 0.3, 1.4}, {0.2, 0.2, 1.4}},                // corner column
+      {{3.0, 5.985, 1.6}, {0.6, 0.015, 0.4}},            // picture
+      {{3.4, 0.015, 1.0}, {0.45, 0.015, 1.0}},           // door
+      {{6.985, 4.3, 1.5}, {0.015, 0.7, 0.5}},            // whiteboard
+      {{1.6, 5.75, 0.35}, {0.5, 0.25, 0.35}},            // low cabinet
+      {{6.6, 5.6, 0.4}, {0.2, 0.2, 0.4}},                // planter
+  };
+  return layout;
+}
+
+cv::Vec3b bgr(int b, int g, int r) {
+  return cv::Vec3b(static_cast<uchar>(b), static_cast<uchar>(g), static_cast<uchar>(r));
+}
+
+// Recipes of one person's clothes, skin and carried box; softer than the static surfaces.
+struct BodyLook {
+  synth::TextureRecipe shirt, trousers, skin, carried_box;
+};
+
+BodyLook body_look(uint64_t body_seed) {
+  cv::RNG rng(body_seed);
+  BodyLook look;
+  const cv::Vec3b shirt(static_cast<uchar>(rng.uniform(30, 220)),
+                        static_cast<uchar>(rng.uniform(30, 220)),
+                        static_cast<uchar>(rng.uniform(30, 220)));
+  look.shirt = {shirt, shirt * 0.55, 0.5, 8.0, 20.0, 2.0, 1.0, 0.7};
+  const int trousers = rng.uniform(25, 90);
+  look.trousers = {bgr(trousers + 25, trousers, trousers - 10), bgr(trousers / 2 + 10, trousers / 2, trousers / 3),
+                   0.4, 4.0, 6.0, 0.0, 0.0, 0.2};
+  const int tone = rng.uniform(0, 3);
+  const cv::Vec3b skins[] = {bgr(150, 180, 225), bgr(95, 135, 185), bgr(50, 80, 120)};
+  look.skin = {skins[tone], skins[tone] * 0.7, 0.3, 10.0, 0.0, 0.0, 0.0, 0.1};
+  // Cardboard with tape and printing: well textured, so trackers do see features on it.
+  look.carried_box = {bgr(45, 95, 140), bgr(110, 170, 215), 0.6, 10.0, 25.0, 10.0, 40.0, 0.3};
+  return look;
+}
+
+// Runs fn(row_begin, row_end) over chunks of rows on `threads` threads. Every pixel's result
+// depends only on its own inputs, so the split never changes the output.
+template <typename Fn>
+void parallel_rows(int height, int threads, const Fn& fn) {
+  std::atomic<int> next_chunk{0};
+  const int chunks = (height + kRowsPerChunk - 1) / kRowsPerChunk;
+  const auto worker = [&] {
+    for (int chunk = next_chunk++; chunk < chunks; chunk = next_chunk++) {
+      fn(chunk * kRowsPerChunk, std::min(height, (chunk + 1) * kRowsPerChunk));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& thread : pool) thread.join();
+}
+
+int resolve_threads(int requested) {
+  if (requested > 0) return requested;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+}  // namespace
+
+SynthTrajectory parse_synth_trajectory(const std::string& name) {
+  if (name == "handheld") return SynthTrajectory::kHandheld;
+  if (name == "loop") return SynthTrajectory::kLoop;
+  throw Error("synth: flag --trajectory expects 'handheld' or 'loop', got '" + name + "'");
+}
+
+std::string to_string(SynthTrajectory trajectory) {
+  return trajectory == SynthTrajectory::kLoop ? "loop" : "handheld";
+}
+
+void SynthOptions::validate() const {
+  if (frames < 1) throw Error("synth: flag --frames must be >= 1, got " + std::to_string(frames));
+  if (bodies < 0 || bodies > kMaxBodies) {
+    throw Error("synth: flag --bodies must be in [0, " + std::to_string(kMaxBodies) + "], got " +
+                std::to_string(bodies));
+  }
+  if (carried_objects < 0) {
+    throw Error("synth: flag --carried-objects must be >= 0, got " +
+                std::to_string(carried_objects));
+  }
+  if (threads < 0) throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
+}
+
+CameraConfig synthetic_camera_config() {
+  CameraConfig config;
+  config.name = "synthetic";
+  config.pinhole = PinholeCamera{};
+  config.pinhole.width = 640;
+  config.pinhole.height = 480;
+  config.pinhole.fx = 525.0;
+  config.pinhole.fy = 525.0;
+  config.pinhole.cx = 319.5;
+  config.pinhole.cy = 239.5;
+  config.pinhole.distortion = {};
+  config.fps = kFps;
+  config.depth_factor = 5000.0;
+  config.depth_threshold = 4.0;
+  return config;
+}
+
+SystemConfig synthetic_system_config() {
+  SystemConfig config;
+  config.camera = synthetic_camera_config();
+  return config;
+}
+
+struct SyntheticScene::Impl {
+  explicit Impl(const SynthOptions& opts);
+  void render(size_t index, SynthFrame& frame, int threads) const;
+
+  SynthOptions options;
+  PinholeCamera camera;
+  synth::RoomLayout room;
+  synth::CameraPath camera_path;
+  synth::DepthSensorModel sensor;
+  std::vector<synth::MipTexture> textures;
+  // Static boxes first (room, then furniture) so their surface ids do not depend on --bodies.
+  std::vector<BoxSurface> static_boxes;
+  std::vector<Pose> static_poses;
+  std::vector<synth::WalkingBody> bodies;
+  std::vector<std::vector<BoxSurface>> body_boxes;  // per body, in WalkingBody::parts() order
+  std::vector<float> column_xn, row_yn;             // normalised ray coordinates of pixel centres
+
+ private:
+  BoxSurface make_box(const Eigen::Vector3d& half, bool inside, uint8_t label,
+                      const synth::TextureRecipe* recipe, float texels_per_metre, uint64_t seed);
+};
+
+SyntheticScene::Impl::Impl(const SynthOptions& opts)
+    : options(opts),
+      camera(synthetic_camera_config().pinhole),
+      camera_path(opts.trajectory == SynthTrajectory::kLoop, opts.seed,
+                  static_cast<double>(std::max<size_t>(opts.frames, 2) - 1) / kFps, room),
+      sensor(opts.seed) {
+  options.validate();
+  options.carried_objects = std::min(options.carried_objects, options.bodies);
+
+  // Static scene: every face gets its own recipe and texture.
+  const uint64_t static_seed = synth::mix_hash(opts.seed, 0x57A71Cu);
+  static_boxes.push_back(make_box(room.size / 2.0, true, kSynthLabelStatic, nullptr,
+                                  kStaticTexelsPerMetre, synth::mix_hash(static_seed, 0)));
+  static_poses.push_back(Pose(Eigen::Translation3d(room.size / 2.0)));
+  for (size_t i = 0; i < furniture_layout().size(); ++i) {
+    const Furniture& item = furniture_layout()[i];
+    static_boxes.push_back(make_box(item.half, false, kSynthLabelStatic, nullptr,
+                                    kStaticTexelsPerMetre, synth::mix_hash(static_seed, i + 1)));
+    Pose pose = Pose::Identity();
+    pose.linear() = Eigen::AngleAxisd(item.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.translation() = item.centre;
+    static_poses.push_back(pose);
+  }
+
+  for (int b = 0; b < options.bodies; ++b) {
+    // Hand-held: people walk laps in front of where the camera mostly looks; loop: round the
+    // whole room, since the loop camera looks in every direction.
+    const std::optional<double> sector =
+        opts.trajectory == SynthTrajectory::kHandheld
+            ? std::optional<double>(camera_path.mean_heading())
+            : std::nullopt;
+    bodies.emplace_back(b, opts.seed, b < options.carried_objects, room, sector);
+    const uint64_t body_seed = synth::mix_hash(opts.seed, 0xB0D7u, static_cast<uint64_t>(b));
+    const BodyLook look = body_look(body_seed);
+    std::vector<synth::BodyPartPose> rest;
+    bodies.back().pose_parts(0.0, rest);
+    std::vector<BoxSurface> boxes;
+    for (size_t p = 0; p < bodies.back().parts().size(); ++p) {
+      const synth::BodyPart part = bodies.back().parts()[p];
+      const synth::TextureRecipe* recipe = &look.shirt;
+      uint8_t label = kSynthLabelPerson;
+      if (part == synth::BodyPart::kHead) recipe = &look.skin;
+      if (part == synth::BodyPart::kLeftLeg || part == synth::BodyPart::kRightLeg) {
+        recipe = &look.trousers;
+      }
+      if (part == synth::BodyPart::kCarriedBox) {
+        recipe = &look.carried_box;
+        label = kSynthLabelCarried;
+      }
+      boxes.push_back(make_box(rest[p].half_extents, false, label, recipe, kBodyTexelsPerMetre,
+                               synth::mix_hash(body_seed, p)));
+    }
+    body_boxes.push_back(std::move(boxes));
+  }
+
+  for (int x = 0; x < camera.width; ++x) {
+    column_xn.push_back(static_cast<float>((x - camera.cx) / camera.fx));
+  }
+  for (int y = 0; y < camera.height; ++y) {
+    row_yn.push_back(static_cast<float>((y - camera.cy) / camera.fy));
+  }
+}
+
+BoxSurface SyntheticScene::Impl::make_box(const Eigen::Vector3d& half, bool inside, uint8_t label,
+                                          const synth::TextureRecipe* recipe,
+                                          float texels_per_metre, uint64_t seed) {
+  BoxSurface box;
+  box.half_extents = half;
+  box.seen_from_inside = inside;
+  box.label = label;
+  for (int face = 0; face < 6; ++face) {
+    const int axis = face / 2;
+    const double width_m = 2.0 * half[(axis + 1) % 3];
+    const double height_m = 2.0 * half[(axis + 2) % 3];
+    const uint64_t face_seed = synth::mix_hash(seed, static_cast<uint64_t>(face));
+    const synth::TextureRecipe face_recipe =
+        recipe ? *recipe : synth::static_surface_recipe(face_seed);
+    box.face_textures[static_cast<size_t>(face)] = static_cast<int>(textures.size());
+    textures.push_back(
+        synth::make_texture(face_recipe, width_m, height_m, texels_per_metre, face_seed));
+  }
+  return box;
+}
+
+void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) const {
+  const double t = static_cast<double>(index) / kFps;
+  frame.index = index;
+  frame.timestamp = kFirstTimestamp + t;
+  frame.T_world_camera = camera_path.T_world_camera(t);
+  const Pose T_camera_world = frame.T_world_camera.inverse();
+
+  // Gather this frame's boxes with their poses.
+  std::vector<std::pair<const BoxSurface*, Pose>> posed;
+  for (size_t i = 0; i < static_boxes.size(); ++i) posed.emplace_back(&static_boxes[i], static_poses[i]);
+  std::vector<synth::BodyPartPose> parts;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b].pose_parts(t, parts);
+    for (size_t p = 0; p < parts.size(); ++p) posed.emplace_back(&body_boxes[b][p], parts[p].T_world_part);
+  }
+
+  const Eigen::Vector3d light_direction = Eigen::Vector3d(0.3, 0.5, 1.0).normalized();
+  std::vector<FrameBox> boxes(posed.size());
+  for (size_t i = 0; i < posed.size(); ++i) {
+    const auto& [surface, T_world_box] = posed[i];
+    FrameBox& box = boxes[i];
+    box.surface = surface;
+    const Pose T_camera_box = T_camera_world * T_world_box;
+    const Pose T_box_camera = T_camera_box.inverse();
+    box.R_box_camera = T_box_camera.linear().cast<float>();
+    box.camera_in_box = T_box_camera.translation().cast<float>();
+    box.half = surface->half_extents.cast<float>();
+    box.first_surface_id = static_cast<uint16_t>(1 + i * 6);
+    for (int face = 0; face < 6; ++face) {
+      Eigen::Vector3d normal = T_world_box.linear().col(face / 2) * (face % 2 ? 1.0 : -1.0);
+      if (surface->seen_from_inside) normal = -normal;
+      box.face_light[static_cast<size_t>(face)] =
+          static_cast<float>(0.6 + 0.3 * std::max(0.0, normal.dot(light_direction)));
+    }
+    // Screen rectangle of the box clipped to the near plane (corners in front of it plus
+    // points where edges cross it); boxes wholly behind the camera get an empty rectangle.
+    box.x0 = 0, box.y0 = 0, box.x1 = camera.width, box.y1 = camera.height;
+    if (!surface->seen_from_inside) {
+      constexpr double kClipZ = 0.02;
+      std::array<Eigen::Vector3d, 8> corners;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d local((corner & 1 ? 1 : -1) * surface->half_extents.x(),
+                                    (corner & 2 ? 1 : -1) * surface->half_extents.y(),
+                                    (corner & 4 ? 1 : -1) * surface->half_extents.z());
+        corners[static_cast<size_t>(corner)] = T_camera_box * local;
+      }
+      double u_min = 1e9, u_max = -1e9, v_min = 1e9, v_max = -1e9;
+      const auto extend = [&](const Eigen::Vector3d& p) {
+        const Eigen::Vector2d uv = camera.project(p);
+        u_min = std::min(u_min, uv.x()), u_max = std::max(u_max, uv.x());
+        v_min = std::min(v_min, uv.y()), v_max = std::max(v_max, uv.y());
+      };
+      for (int a = 0; a < 8; ++a) {
+        const Eigen::Vector3d& pa = corners[static_cast<size_t>(a)];
+        if (pa.z() >= kClipZ) extend(pa);
+        for (int bit = 1; bit < 8; bit <<= 1) {  // the 3 edges from corner a to a larger index
+          if (a & bit) continue;
+          const Eigen::Vector3d& pb = corners[static_cast<size_t>(a | bit)];
+          if ((pa.z() < kClipZ) != (pb.z() < kClipZ)) {
+            extend(pa + (pb - pa) * ((kClipZ - pa.z()) / (pb.z() - pa.z())));
+          }
+        }
+      }
+      if (u_min > u_max) {
+        box.x1 = box.x0;  // nothing in front of the camera
+      } else {
+        box.x0 = static_cast<int>(std::clamp(std::floor(u_min) - 1.0, 0.0, double(camera.width)));
+        box.x1 = static_cast<int>(std::clamp(std::ceil(u_max) + 2.0, 0.0, double(camera.width)));
+        box.y0 = static_cast<int>(std::clamp(std::floor(v_min) - 1.0, 0.0, double(camera.height)));
+        box.y1 = static_cast<int>(std::clamp(std::ceil(v_max) + 2.0, 0.0, double(camera.height)));
+      }
+    }
+  }
+
+  const int width = camera.width, height = camera.height;
+  frame.bgr.create(height, width, CV_8UC3);
+  frame.depth.create(height, width, CV_32F);
+  frame.labels.create(height, width, CV_8U);
+  frame.surface_ids.create(height, width, CV_16U);
+  cv::Mat incidence_cos(height, width, CV_32F);
+  const Eigen::Matrix3f R_world_camera = frame.T_world_camera.linear().cast<float>();
+  const Eigen::Vector3f t_world_camera = frame.T_world_camera.translation().cast<float>();
+  const Eigen::Vector3f light_a(2.3f, 3.0f, 2.6f), light_b(4.9f, 3.0f, 2.6f);
+  const float focal = static_cast<float>(camera.fx);
+
+  parallel_rows(height, threads, [&](int row_begin, int row_end) {
+    // Pass 1: nearest hit per pixel (z-buffer over exact ray-box intersections).
+    for (int y = row_begin; y < row_end; ++y) {
+      std::fill_n(frame.depth.ptr<float>(y), width, std::numeric_limits<float>::infinity());
+      std::fill_n(frame.surface_ids.ptr<uint16_t>(y), width, uint16_t{0});
+    }
+    for (const FrameBox& box : boxes) {
+      const int y_begin = std::max(row_begin, box.y0), y_end = std::min(row_end, box.y1);
+      const Eigen::Vector3f& o = box.camera_in_box;
+      const Eigen::Vector3f& h = box.half;
+      const bool inside = box.surface->seen_from_inside;
+      for (int y = y_begin; y < y_end; ++y) {
+        float* depth_row = frame.depth.ptr<float>(y);
+        uint16_t* id_row = frame.surface_ids.ptr<uint16_t>(y);
+        const Eigen::Vector3f row_part = box.R_box_camera.col(1) * row_yn[y] + box.R_box_camera.col(2);
+        for (int x = box.x0; x < box.x1; ++x) {
+          const Eigen::Vector3f d = box.R_box_camera.col(0) * column_xn[x] + row_part;
+          float t_enter = kNearPlane_m, t_exit = depth_row[x];
+          int enter_axis = -1, exit_axis = -1;
+          bool hit = true;
+          for (int a = 0; a < 3; ++a) {
+            const float inv = 1.0f / d[a];
+            float t0 = (-h[a] - o[a]) * inv, t1 = (h[a] - o[a]) * inv;
+            if (t0 > t1) std::swap(t0, t1);
+            if (t0 > t_enter) t_enter = t0, enter_axis = a;
+            if (t1 < t_exit || (inside && exit_axis < 0)) t_exit = t1, exit_axis = a;
+            if (!inside && t_enter > t_exit) {
+              hit = false;
+              break;
+            }
+          }
+          if (inside) {
+            // Seen from within: the visible face is where the ray leaves the box.
+            if (exit_axis < 0 || !(t_exit < depth_row[x])) continue;
+            depth_row[x] = t_exit;
+            id_row[x] = static_cast<uint16_t>(box.first_surface_id + 2 * exit_axis +
+                                              (d[exit_axis] > 0 ? 1 : 0));
+          } else if (hit && enter_axis >= 0) {
+            depth_row[x] = t_enter;
+            id_row[x] = static_cast<uint16_t>(box.first_surface_id + 2 * enter_axis +
+                                              (d[enter_axis] > 0 ? 0 : 1));
+          }
+        }
+      }
+    }
+
+    // Pass 2: shade the visible surface of every pixel from its own surface coordinates.
+    for (int y = row_begin; y < row_end; ++y) {
+      float* depth_row = frame.depth.ptr<float>(y);
+      const uint16_t* id_row = frame.surface_ids.ptr<uint16_t>(y);
+      auto* colour_row = frame.bgr.ptr<cv::Vec3b>(y);
+      uint8_t* label_row = frame.labels.ptr<uint8_t>(y);
+      float* cos_row = incidence_cos.ptr<float>(y);
+      for (int x = 0; x < width; ++x) {
+        if (id_row[x] == 0) {  // cannot happen inside the closed room; kept safe anyway
+          depth_row[x] = 0.0f;
+          colour_row[x] = cv::Vec3b(0, 0, 0);
+          label_row[x] = kSynthLabelStatic;
+          cos_row[x] = 0.0f;
+          continue;
+        }
+        const int box_index = (id_row[x] - 1) / 6, face = (id_row[x] - 1) % 6, axis = face / 2;
+        const FrameBox& box = boxes[static_cast<size_t>(box_index)];
+        const float z = depth_row[x];
+        const float xn = column_xn[x], yn = row_yn[y];
+        const Eigen::Vector3f d = box.R_box_camera * Eigen::Vector3f(xn, yn, 1.0f);
+        const Eigen::Vector3f p = box.camera_in_box + z * d;
+        const float s = p[(axis + 1) % 3] + box.half[(axis + 1) % 3];
+        const float r = p[(axis + 2) % 3] + box.half[(axis + 2) % 3];
+        const float ray_length = d.norm();
+        const float cosine = std::abs(d[axis]) / ray_length;
+        const float footprint = z * ray_length / (focal * std::sqrt(std::max(cosine, 0.05f)));
+        const cv::Vec3f albedo =
+            textures[static_cast<size_t>(box.surface->face_textures[static_cast<size_t>(face)])]
+                .sample(s, r, footprint);
+        // View-independent light: the face's diffuse term plus two ceiling lamps.
+        const Eigen::Vector3f world = R_world_camera * Eigen::Vector3f(xn * z, yn * z, z) + t_world_camera;
+        const float lamp = 0.35f / (1.0f + (world - light_a).squaredNorm() / 3.0f) +
+                           0.35f / (1.0f + (world - light_b).squaredNorm() / 3.0f);
+        const float shade = box.face_light[static_cast<size_t>(face)] + lamp;
+        colour_row[x] = cv::Vec3b(cv::saturate_cast<uchar>(albedo[0] * shade),
+                                  cv::saturate_cast<uchar>(albedo[1] * shade),
+                                  cv::saturate_cast<uchar>(albedo[2] * shade));
+        label_row[x] = box.surface->label;
+        cos_row[x] = cosine;
+      }
+    }
+  });
+
+  if (options.depth_noise) {
+    sensor.apply(frame.depth, incidence_cos, index, frame.depth_sensor);
+  } else {
+    frame.depth_sensor.create(height, width, CV_32F);
+    for (int y = 0; y < height; ++y) {
+      const float* exact = frame.depth.ptr<float>(y);
+      float* out = frame.depth_sensor.ptr<float>(y);
+      for (int x = 0; x < width; ++x) out[x] = synth::quantise_depth(exact[x], 5000.0);
+    }
+  }
+}
+
+SyntheticScene::SyntheticScene(const SynthOptions& options)
+    : impl_(std::make_unique<const Impl>(options)) {}
+SyntheticScene::~SyntheticScene() = default;
+SyntheticScene::SyntheticScene(SyntheticScene&&) noexcept = default;
+SyntheticScene& SyntheticScene::operator=(SyntheticScene&&) noexcept = default;
+
+SynthFrame SyntheticScene::render(size_t index) const {
+  SynthFrame frame;
+  render(index, frame, impl_->options.threads);
+  return frame;
+}
+
+void SyntheticScene::render(size_t index, SynthFrame& frame, int threads) const {
+  if (index >= impl_->options.frames) {
+    throw Error("synth: frame index " + std::to_string(index) + " is past the sequence end (" +
+                std::to_string(impl_->options.frames) + " frames)");
+  }
+  impl_->render(index, frame, resolve_threads(threads));
+}
+
+const PinholeCamera& SyntheticScene::camera() const { return impl_->camera; }
+const SynthOptions& SyntheticScene::options() const { return impl_->options; }
+size_t SyntheticScene::frame_count() const { return impl_->options.frames; }
+
+Timestamp SyntheticScene::timestamp(size_t index) const {
+  return kFirstTimestamp + static_cast<double>(index) / kFps;
+}
+
+Pose SyntheticScene::camera_pose(size_t index) const {
+  return impl_->camera_path.T_world_camera(static_cast<double>(index) / kFps);
+}
+
+Trajectory SyntheticScene::ground_truth() const {
+  Trajectory trajectory;
+  for (size_t i = 0; i < frame_count(); ++i) trajectory.push_back({timestamp(i), camera_pose(i)});
+  return trajectory;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <cstdint>
+
+namespace pspslam {
+
+// ORB-SLAM2's RGB-D keyframe criteria, as a pure function of one frame's tracking statistics.
+struct KeyFramePolicyOptions {
+  int min_frames_between = 0;   // frames since the last keyframe before an idle mapper may get one
+  int max_frames_between = 30;  // frames after which a keyframe is due (camera fps)
+  int max_queued_keyframes = 3;
+  int close_tracked_limit = 100;    // fewer tracked close points than this ...
+  int close_untracked_min = 70;     // ... and more untracked close ones: need a keyframe
+};
+
+struct KeyFrameEvidence {
+  std::uint64_t frame_id = 0;
+  std::uint64_t last_keyframe_frame_id = 0;
+  std::uint64_t last_relocalisation_frame_id = 0;
+  int keyframes_in_map = 0;
+  int tracked_inliers = 0;            // matched map points after local map tracking
+  int reference_tracked_points = 0;   // points of the reference keyframe with enough observations
+  int tracked_close_points = 0;       // depth in (0, depth_threshold) and matched
+  int untracked_close_points = 0;     // depth in (0, depth_threshold) and unmatched
+  bool mapper_idle = true;
+  int mapper_queue = 0;
+};
+
+enum class KeyFrameDecision {
+  kSkip,
+  kInsert,
+  kInsertInterruptingMapper,  // wanted while the mapper is busy: stop its BA, queue the keyframe
+  kInterruptMapper,           // wanted, queue full: stop its BA, try again next frame
+};
+
+KeyFrameDecision decide_keyframe(const KeyFrameEvidence& evidence,
+                                 const KeyFramePolicyOptions& options);
+
+}  // namespace pspslam

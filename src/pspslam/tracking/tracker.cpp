@@ -1,0 +1,309 @@
+#include "pspslam/tracking/tracker.h"
+
+#include <mutex>
+
+#include "pspslam/map/keyframe.h"
+#include "pspslam/map/map.h"
+#include "pspslam/map/map_point.h"
+#include "pspslam/solve/pnp_ransac.h"
+#include "pspslam/tracking/keyframe_builder.h"
+#include "pspslam/tracking/keyframe_sink.h"
+
+namespace pspslam {
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized:
+      return "not_initialized";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+const char* to_string(TrackingMethod method) {
+  switch (method) {
+    case TrackingMethod::kNone:
+      return "none";
+    case TrackingMethod::kInitialization:
+      return "initialization";
+    case TrackingMethod::kMotionModel:
+      return "motion_model";
+    case TrackingMethod::kReferenceKeyFrame:
+      return "reference_keyframe";
+    case TrackingMethod::kRecovery:
+      return "recovery";
+  }
+  return "?";
+}
+
+Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options)
+    : map_(map),
+      sink_(sink),
+      options_(std::move(options)),
+      local_map_(options_.max_local_keyframes) {}
+
+TrackResult Tracker::track(Frame frame) {
+  std::lock_guard map_lock(map_.update_mutex());
+  TrackResult result;
+  result.frame_id = frame.id();
+  result.timestamp = frame.timestamp();
+  result.num_keypoints = frame.size();
+
+  if (state_ == TrackingState::kNotInitialized) {
+    if (initialize(frame)) {
+      state_ = TrackingState::kOk;
+      result.method = TrackingMethod::kInitialization;
+      result.keyframe_inserted = true;
+      result.num_inliers = frame.size();
+    }
+  } else {
+    if (last_frame_) replace_replaced_points(*last_frame_);
+    bool ok = false;
+    if (state_ == TrackingState::kOk && velocity_ && last_frame_ && last_frame_->has_pose()) {
+      ok = track_with_motion_model(frame);
+      if (ok) result.method = TrackingMethod::kMotionModel;
+    }
+    if (!ok) {
+      const bool recovering = state_ == TrackingState::kLost;
+      ok = track_reference_keyframe(frame, recovering);
+      if (ok) {
+        result.method =
+            recovering ? TrackingMethod::kRecovery : TrackingMethod::kReferenceKeyFrame;
+        if (recovering) last_recovery_frame_id_ = frame.id();
+      }
+    }
+    if (ok) ok = track_local_map(frame);
+    if (ok) {
+      state_ = TrackingState::kOk;
+      result.num_inliers = 0;
+      for (int i = 0; i < frame.size(); ++i) {
+        if (frame.map_points[i] && !frame.outlier[i]) ++result.num_inliers;
+      }
+      maybe_insert_keyframe(frame, result);
+    } else {
+      state_ = TrackingState::kLost;
+      result.method = TrackingMethod::kNone;
+      frame.clear_pose();
+    }
+  }
+
+  result.state = state_;
+  if (state_ == TrackingState::kOk && frame.has_pose()) {
+    result.T_world_camera = frame.T_world_camera();
+    if (last_tracked_pose_ && last_frame_ && last_frame_->has_pose()) {
+      velocity_ = frame.T_camera_world() * last_frame_->T_camera_world().inverse();
+    } else {
+      velocity_.reset();
+    }
+    last_tracked_pose_ = frame.T_camera_world();
+  } else {
+    velocity_.reset();
+  }
+  // Outliers are not kept for the next frame's motion model.
+  for (int i = 0; i < frame.size(); ++i) {
+    if (frame.outlier[i]) frame.map_points[i] = nullptr;
+  }
+  last_frame_.emplace(std::move(frame));
+  return result;
+}
+
+bool Tracker::initialize(Frame& frame) {
+  int with_depth = 0;
+  for (int i = 0; i < frame.size(); ++i) with_depth += frame.depth(i) > 0.0f ? 1 : 0;
+  if (with_depth < options_.min_initial_depth_points) return false;
+  // The first camera defines the world frame.
+  frame.set_pose(Pose::Identity());
+  reference_keyframe_ = create_keyframe(frame, map_, /*initial=*/true);
+  last_keyframe_frame_id_ = frame.id();
+  local_map_.update(frame);
+  if (sink_ != nullptr) sink_->insert_keyframe(reference_keyframe_);
+  return true;
+}
+
+void Tracker::replace_replaced_points(Frame& frame) const {
+  for (auto& point : frame.map_points) {
+    if (!point) continue;
+    if (auto replacement = point->replaced_by()) point = replacement;
+  }
+}
+
+int Tracker::discard_outliers(Frame& frame) {
+  int matched_in_map = 0;
+  for (int i = 0; i < frame.size(); ++i) {
+    if (!frame.map_points[i]) continue;
+    if (frame.outlier[i]) {
+      frame.map_points[i] = nullptr;
+      frame.outlier[i] = 0;
+    } else if (frame.map_points[i]->num_observations() > 0) {
+      ++matched_in_map;
+    }
+  }
+  return matched_in_map;
+}
+
+int Tracker::optimize_frame_pose(Frame& frame) {
+  observations_.clear();
+  observation_keypoint_.clear();
+  const ScalePyramid& pyramid = frame.pyramid();
+  for (int i = 0; i < frame.size(); ++i) {
+    const auto& point = frame.map_points[i];
+    if (!point) continue;
+    const cv::KeyPoint& kp = frame.keypoints()[i];
+    observations_.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
+                             static_cast<double>(frame.right_u(i)),
+                             pyramid.inv_sigma2[kp.octave]});
+    observation_keypoint_.push_back(i);
+  }
+  const PoseOptimizationResult optimized =
+      optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
+                    observations_, options_.pose_optimizer);
+  frame.set_pose(optimized.T_camera_world);
+  for (size_t k = 0; k < observation_keypoint_.size(); ++k) {
+    frame.outlier[observation_keypoint_[k]] = optimized.inlier[k] ? 0 : 1;
+  }
+  return optimized.num_inliers;
+}
+
+bool Tracker::track_with_motion_model(Frame& frame) {
+  frame.set_pose(*velocity_ * last_frame_->T_camera_world());
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  int matches = search_previous_frame(frame, *last_frame_, options_.motion_search_radius,
+                                      options_.matcher);
+  if (matches < options_.min_motion_matches) {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = search_previous_frame(frame, *last_frame_, 2.0 * options_.motion_search_radius,
+                                    options_.matcher);
+  }
+  if (matches < options_.min_motion_matches) return false;
+  optimize_frame_pose(frame);
+  return discard_outliers(frame) >= options_.min_pose_inliers;
+}
+
+bool Tracker::track_reference_keyframe(Frame& frame, bool recovering) {
+  if (!reference_keyframe_ || !last_tracked_pose_) return false;
+  // After losing track, reference keyframe may have been replaced by a better one in local
+  // mapping culling; fall back to the newest keyframe in the map in that case.
+  if (reference_keyframe_->is_bad()) {
+    const auto keyframes = map_.keyframes();
+    if (keyframes.empty()) return false;
+    reference_keyframe_ = keyframes.back();
+  }
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outlier.begin(), frame.outlier.end(), 0);
+  MatcherOptions matcher = options_.matcher;
+  matcher.nn_ratio = 0.7;  // stricter than projection: nothing constrains the match position
+  const int matches = search_keyframe_brute_force(frame, *reference_keyframe_, matcher);
+  if (matches < options_.min_reference_matches) return false;
+
+  Pose initial = *last_tracked_pose_;
+  if (recovering) {
+    // The last pose may be stale: estimate one from the matches alone.
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<int> keypoint;
+    for (int i = 0; i < frame.size(); ++i) {
+      if (!frame.map_points[i]) continue;
+      points.push_back(frame.map_points[i]->position());
+      pixels.emplace_back(frame.keypoints()[i].pt.x, frame.keypoints()[i].pt.y);
+      keypoint.push_back(i);
+    }
+    const PnpRansacResult pnp = solve_pnp_ransac(frame.camera().pinhole, points, pixels);
+    if (!pnp.success) return false;
+    initial = pnp.T_camera_world;
+    for (size_t k = 0; k < keypoint.size(); ++k) {
+      if (!pnp.inlier[k]) frame.map_points[keypoint[k]] = nullptr;
+    }
+  }
+  frame.set_pose(initial);
+  optimize_frame_pose(frame);
+  return discard_outliers(frame) >= options_.min_pose_inliers;
+}
+
+bool Tracker::track_local_map(Frame& frame) {
+  if (auto reference = local_map_.update(frame)) reference_keyframe_ = reference;
+
+  // Points already matched are not searched again; record that they were seen.
+  const std::uint64_t frame_id = frame.id();
+  for (int i = 0; i < frame.size(); ++i) {
+    const auto& point = frame.map_points[i];
+    if (!point) continue;
+    if (point->is_bad()) {
+      frame.map_points[i] = nullptr;
+      continue;
+    }
+    point->increase_visible();
+    point->last_seen_frame = frame_id;
+  }
+  projected_.clear();
+  for (const auto& point : local_map_.points()) {
+    if (point->last_seen_frame == frame_id || point->is_bad()) continue;
+    ProjectedPoint p;
+    if (project_map_point(point, frame, p)) {
+      point->increase_visible();
+      projected_.push_back(std::move(p));
+    }
+  }
+  if (!projected_.empty()) {
+    const bool just_recovered = frame.id() < last_recovery_frame_id_ + 2;
+    search_by_projection(frame, projected_,
+                         options_.local_map_search_radius * (just_recovered ? 5.0 / 3.0 : 1.0),
+                         options_.matcher);
+  }
+  map_.set_reference_map_points(local_map_.points());
+
+  optimize_frame_pose(frame);
+  int inliers = 0;
+  for (int i = 0; i < frame.size(); ++i) {
+    const auto& point = frame.map_points[i];
+    if (!point) continue;
+    if (!frame.outlier[i]) {
+      point->increase_found();
+      if (point->num_observations() > 0) ++inliers;
+    }
+  }
+  const bool recent_recovery =
+      last_recovery_frame_id_ > 0 && frame.id() < last_recovery_frame_id_ + 30;
+  const int needed = recent_recovery ? options_.min_local_map_inliers_after_recovery
+                                     : options_.min_local_map_inliers;
+  return inliers >= needed;
+}
+
+void Tracker::maybe_insert_keyframe(Frame& frame, TrackResult& result) {
+  KeyFrameEvidence evidence;
+  evidence.frame_id = frame.id();
+  evidence.last_keyframe_frame_id = last_keyframe_frame_id_;
+  evidence.last_relocalisation_frame_id = last_recovery_frame_id_;
+  evidence.keyframes_in_map = static_cast<int>(map_.num_keyframes());
+  evidence.tracked_inliers = result.num_inliers;
+  const int min_observations = evidence.keyframes_in_map <= 2 ? 2 : 3;
+  evidence.reference_tracked_points =
+      reference_keyframe_ ? reference_keyframe_->tracked_map_points(min_observations) : 0;
+  const double depth_threshold = frame.camera().depth_threshold;
+  for (int i = 0; i < frame.size(); ++i) {
+    const float z = frame.depth(i);
+    if (z <= 0.0f || z >= depth_threshold) continue;
+    if (frame.map_points[i] && !frame.outlier[i]) {
+      ++evidence.tracked_close_points;
+    } else {
+      ++evidence.untracked_close_points;
+    }
+  }
+  evidence.mapper_idle = sink_ == nullptr || sink_->accepts_keyframes();
+  evidence.mapper_queue = sink_ == nullptr ? 0 : static_cast<int>(sink_->queued_keyframes());
+
+  const KeyFrameDecision decision = decide_keyframe(evidence, options_.keyframes);
+  if (decision == KeyFrameDecision::kSkip) return;
+  if (sink_ != nullptr && decision != KeyFrameDecision::kInsert) {
+    sink_->interrupt_bundle_adjustment();
+  }
+  if (decision == KeyFrameDecision::kInterruptMapper) return;
+  reference_keyframe_ = create_keyframe(frame, map_, /*initial=*/false);
+  last_keyframe_frame_id_ = frame.id();
+  result.keyframe_inserted = true;
+  if (sink_ != nullptr) sink_->insert_keyframe(reference_keyframe_);
+}
+
+}  // namespace pspslam

@@ -1,0 +1,106 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "pspslam/core/types.h"
+#include "pspslam/map/frame.h"
+#include "pspslam/match/orb_matcher.h"
+#include "pspslam/optimize/pose_optimizer.h"
+#include "pspslam/tracking/keyframe_policy.h"
+#include "pspslam/tracking/local_map.h"
+
+namespace pspslam {
+
+class KeyFrame;
+class KeyFrameSink;
+class Map;
+
+struct TrackerOptions {
+  int min_initial_depth_points = 500;     // keypoints with depth needed to start the map
+  double motion_search_radius = 7.0;      // pixels at level 0 (ORB-SLAM2 RGB-D)
+  int min_motion_matches = 20;            // below: search again with twice the radius
+  int min_pose_inliers = 10;              // motion model / reference keyframe success
+  int min_reference_matches = 15;
+  double local_map_search_radius = 3.0;   // ORB-SLAM2 RGB-D window factor
+  int min_local_map_inliers = 30;
+  int min_local_map_inliers_after_recovery = 50;
+  size_t max_local_keyframes = 80;
+  KeyFramePolicyOptions keyframes;
+  MatcherOptions matcher;
+  PoseOptimizerOptions pose_optimizer;
+};
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+
+// How the frame's pose was first estimated before local map tracking refined it.
+enum class TrackingMethod { kNone, kInitialization, kMotionModel, kReferenceKeyFrame, kRecovery };
+
+const char* to_string(TrackingState state);
+const char* to_string(TrackingMethod method);
+
+struct TrackResult {
+  std::uint64_t frame_id = 0;
+  Timestamp timestamp = 0.0;
+  TrackingState state = TrackingState::kNotInitialized;
+  TrackingMethod method = TrackingMethod::kNone;
+  // Set only when the frame was tracked: a lost frame gets no pose, never an invented one.
+  std::optional<Pose> T_world_camera;
+  bool keyframe_inserted = false;
+  int num_keypoints = 0;
+  int num_inliers = 0;  // map point matches after local map tracking
+};
+
+// Tracking of each frame (ORB-SLAM2 RGB-D semantics): map initialisation from the first frame
+// with enough depth, constant-velocity motion model, reference-keyframe fallback, local map
+// tracking, keyframe decision. When tracking fails the frame is reported lost and the next
+// frames try again against the reference keyframe (with PnP-RANSAC from the matches, since
+// the last pose may be stale); no new map is started, so all poses stay in one world frame.
+//
+// Not thread-safe: one thread calls track(). It holds map.update_mutex() while it works on a
+// frame, so local mapping cannot rewrite poses or points under it.
+class Tracker {
+ public:
+  // `map` and `sink` must outlive the tracker; `sink` may be null (no local mapping).
+  Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options = {});
+
+  TrackResult track(Frame frame);
+
+  TrackingState state() const { return state_; }
+  const TrackerOptions& options() const { return options_; }
+
+ private:
+  bool initialize(Frame& frame);
+  bool track_with_motion_model(Frame& frame);
+  bool track_reference_keyframe(Frame& frame, bool recovering);
+  bool track_local_map(Frame& frame);
+  void maybe_insert_keyframe(Frame& frame, TrackResult& result);
+
+  // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
+  int optimize_frame_pose(Frame& frame);
+  // Drops outlier matches; returns how many matches with map observations remain.
+  static int discard_outliers(Frame& frame);
+  void replace_replaced_points(Frame& frame) const;
+
+  Map& map_;
+  KeyFrameSink* sink_;
+  TrackerOptions options_;
+  TrackingState state_ = TrackingState::kNotInitialized;
+
+  std::optional<Frame> last_frame_;        // the previous frame (tracked or not)
+  std::optional<Pose> velocity_;           // T_current_last of the last two tracked frames
+  std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
+  std::shared_ptr<KeyFrame> reference_keyframe_;
+  std::uint64_t last_keyframe_frame_id_ = 0;
+  std::uint64_t last_recovery_frame_id_ = 0;
+  LocalMap local_map_;
+
+  // Reused per-frame buffers (no allocation per keypoint).
+  std::vector<PoseObservation> observations_;
+  std::vector<int> observation_keypoint_;
+  std::vector<ProjectedPoint> projected_;
+};
+
+}  // namespace pspslam

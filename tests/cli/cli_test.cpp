@@ -1,0 +1,199 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/io/trajectory_io.h"
+#include "support/test_support.h"
+
+namespace pspslam {
+namespace {
+
+struct Result {
+  int status = 0;
+  std::string output;
+};
+
+Result pspslam(const std::string& arguments) {
+  Result result;
+  result.status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " " + arguments, &result.output);
+  return result;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+size_t count_of(const std::string& text, const std::string& part) {
+  size_t count = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++count;
+  return count;
+}
+
+// 1 m/s along x for `seconds` at 30 Hz; the estimate is `speed` m/s, shifted by 2 m in y.
+void write_trajectories(const std::filesystem::path& dir, double speed, double seconds = 5.0) {
+  Trajectory gt, estimate;
+  for (int i = 0; i <= static_cast<int>(seconds * 30); ++i) {
+    StampedPose p;
+    p.timestamp = 200.0 + i / 30.0;
+    p.T_world_camera.translation() = Eigen::Vector3d(i / 30.0, 0.0, 0.5 * std::sin(i / 20.0));
+    gt.push_back(p);
+    p.T_world_camera.translation() =
+        Eigen::Vector3d(speed * i / 30.0, 2.0, 0.5 * std::sin(i / 20.0));
+    estimate.push_back(p);
+  }
+  write_tum_trajectory(dir / "gt.txt", gt);
+  write_tum_trajectory(dir / "est.txt", estimate);
+}
+
+std::filesystem::path make_sequence(const std::string& tag, bool with_config) {
+  const auto dir = testing::make_temp_dir(tag);
+  std::filesystem::create_directories(dir / "rgb");
+  std::filesystem::create_directories(dir / "depth");
+  std::ofstream rgb(dir / "rgb.txt"), depth(dir / "depth.txt"), gt(dir / "groundtruth.txt");
+  for (int i = 0; i < 3; ++i) {
+    const std::string stamp = std::to_string(10 + i) + ".5";
+    cv::imwrite((dir / "rgb" / (stamp + ".png")).string(), cv::Mat(6, 8, CV_8UC3, cv::Scalar(1, 2, 3)));
+    cv::imwrite((dir / "depth" / (stamp + ".png")).string(), cv::Mat(6, 8, CV_16UC1, cv::Scalar(5000)));
+    rgb << stamp << " rgb/" << stamp << ".png\n";
+    depth << stamp << " depth/" << stamp << ".png\n";
+    gt << stamp << " 0 0 " << i << " 0 0 0 1\n";
+  }
+  if (with_config) {
+    std::ofstream(dir / "config.yaml")
+        << "camera:\n  width: 8\n  height: 6\n  fx: 10\n  fy: 10\n  cx: 4\n  cy: 3\n"
+           "  distortion: [0, 0, 0, 0]\n  fps: 1\n  depth_factor: 5000\n  depth_threshold: 3\n";
+  }
+  return dir;
+}
+
+TEST(CliEval, MissingRequiredFlag) {
+  const Result r = pspslam("eval --est x.txt");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: pspslam eval: missing required flag --gt (see 'pspslam eval --help')\n");
+}
+
+TEST(CliEval, UnknownFlag) {
+  const Result r = pspslam("eval --gt a --est b --plots out");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: pspslam eval: unknown flag --plots (see 'pspslam eval --help')\n");
+}
+
+TEST(CliEval, HelpListsFlags) {
+  const Result r = pspslam("eval --help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* flag : {"--gt", "--est", "--max-dt", "--offset", "--sim3", "--rpe-delta",
+                           "--rpe-unit", "--json", "--plot"}) {
+    EXPECT_TRUE(contains(r.output, flag)) << flag;
+  }
+}
+
+TEST(CliEval, BadValuesAndFiles) {
+  const auto dir = testing::make_temp_dir("cli");
+  write_trajectories(dir, 1.0);
+  const std::string files = " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
+  Result r = pspslam("eval" + files + " --rpe-unit m");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: pspslam eval: flag --rpe-unit expects 's' or 'f', got 'm'\n");
+  r = pspslam("eval" + files + " --max-dt fast");
+  EXPECT_EQ(r.output, "error: pspslam eval: flag --max-dt expects a number, got 'fast'\n");
+  r = pspslam("eval --gt " + (dir / "none.txt").string() + " --est " + (dir / "est.txt").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: " + (dir / "none.txt").string() + ": cannot open trajectory file\n");
+  std::ofstream(dir / "bad.txt") << "# estimate\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 1\n";
+  r = pspslam("eval --gt " + (dir / "gt.txt").string() + " --est " + (dir / "bad.txt").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: " + (dir / "bad.txt").string() +
+                          ":3: expected 8 fields 'timestamp tx ty tz qx qy qz qw', got 7\n");
+}
+
+TEST(CliEval, TableJsonAndPlots) {
+  const auto dir = testing::make_temp_dir("cli");
+  write_trajectories(dir, 1.1);  // 0.1 m/s translation drift
+  const std::string files = " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
+  Result r = pspslam("eval" + files);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "alignment:    SE(3), scale 1.000000")) << r.output;
+  EXPECT_TRUE(contains(r.output, "  RPE translation        m         120     0.1000     0.1000"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "  RPE translation rate   m/s       120     0.1000")) << r.output;
+  EXPECT_TRUE(contains(r.output, "  ATE                    m         151 ")) << r.output;
+
+  r = pspslam("eval" + files + " --json --sim3 --plot " + (dir / "plots").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"ate\": {\"alignment\": \"sim3\", \"max_dt_s\": 0.02"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "\"rpe\": {\"delta\": 1, \"delta_unit\": \"s\"")) << r.output;
+  // With scale the 1.1x copy fits exactly: ATE rmse ~ 0, printed in full precision.
+  EXPECT_TRUE(contains(r.output, "\"scale\": 0.90909090909")) << r.output;
+  for (const char* name : {"trajectory_top_view.png", "trajectory_top_view.svg",
+                           "ate_over_time.png", "ate_over_time.svg"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "plots" / name)) << name;
+  }
+}
+
+TEST(CliRun, MissingSequenceFlagAndConfig) {
+  Result r = pspslam("run");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: missing required flag --sequence (see 'pspslam run --help')\n");
+  const auto dir = make_sequence("cli", false);
+  r = pspslam("run --sequence " + dir.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: " + dir.string() + ": no camera config: --config was not given and " +
+                          (dir / "config.yaml").string() +
+                          " does not exist (pass a preset, e.g. --config config/bonn.yaml)\n");
+  r = pspslam("run --sequence " + (dir / "absent").string());
+  EXPECT_EQ(r.output, "error: " + (dir / "absent").string() + ": sequence directory not found\n");
+}
+
+TEST(CliRun, EightBitDepthStopsWithTheFileName) {
+  const auto dir = make_sequence("cli", true);
+  // The first frame, so the error comes from loading it, before any SLAM work.
+  cv::imwrite((dir / "depth" / "10.5.png").string(), cv::Mat(6, 8, CV_8UC1, cv::Scalar(9)));
+  const Result r = pspslam("run --sequence " + dir.string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: " + (dir / "depth" / "10.5.png").string() +
+                                     ": depth image must be 16-bit single-channel (got 8-bit, 1 "
+                                     "channel)\n"))
+      << r.output;
+}
+
+TEST(CliRun, ConfigOfWrongImageSize) {
+  const auto dir = make_sequence("cli", false);
+  const Result r = pspslam("run --sequence " + dir.string() + " --out " + (dir / "out").string() +
+                           " --config " + (source_dir() / "config" / "bonn.yaml").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: " + (dir / "rgb" / "10.5.png").string() +
+                                     " is 8x6 but the config " +
+                                     (source_dir() / "config" / "bonn.yaml").string() +
+                                     " says camera 640x480\n"))
+      << r.output;
+}
+
+TEST(CliRun, BonnCrowdDevSequenceReport) {
+  PSPSLAM_SHARED_OR_SKIP(shared);
+  const auto dir = shared / "data" / "bonn_crowd_dev";
+  const auto out = testing::make_temp_dir("cli");
+  // One frame is enough to check what `run` reports about the input before SLAM starts.
+  const Result r = pspslam("run --max-frames 1 --sequence " + dir.string() + " --out " +
+                           out.string() + " --config " +
+                           (source_dir() / "config" / "bonn.yaml").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(count_of(r.output, "warning:"), 1u) << r.output;
+  EXPECT_TRUE(contains(r.output, "warning: " + dir.string() +
+                                     ": 2 listed files are missing; skipped 0 frames (first: "
+                                     "depth/1548339819.85514.png)\n"));
+  EXPECT_TRUE(contains(r.output,
+                       "frames:       400 (400 colour and 403 depth files listed, associated "
+                       "within 0.02 s; 2 listed files missing, 0 frames skipped)"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "time span:    13.374 s")) << r.output;
+  EXPECT_TRUE(contains(r.output, "ground truth: yes (404 poses in groundtruth.txt)")) << r.output;
+  // Whatever SLAM made of one frame, the trajectory file is a valid TUM file.
+  EXPECT_NO_THROW(read_tum_trajectory(out / "trajectory.txt"));
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -1,0 +1,195 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+#include "pspslam/geometry/ant_colony_search.h"
+#include "pspslam/geometry/convex_hull.h"
+
+namespace pspslam {
+namespace {
+
+const cv::Size kImage(640, 480);
+
+struct PlantedSet {
+  std::vector<Eigen::Vector2f> points;
+  std::vector<int> cluster;  // -1 = static background, else planted cluster id
+  int clusters = 0;
+};
+
+enum class Density { sparse, dense, clustered };
+
+// Background points plus planted dynamic discs (radius 30-60 px, i.e. a person's limb to torso at
+// a few metres).
+PlantedSet make_set(Density density, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> x(0.0f, 639.0f), y(0.0f, 479.0f), unit(0.0f, 1.0f);
+  PlantedSet set;
+  const int background = density == Density::sparse ? 300 : 2000;
+  if (density == Density::clustered) {
+    // Texture clumps: background concentrated in a few blobs, like ORB on real scenes.
+    std::normal_distribution<float> spread(0.0f, 25.0f);
+    for (int blob = 0; blob < 40; ++blob) {
+      const Eigen::Vector2f c(x(rng), y(rng));
+      for (int k = 0; k < background / 40; ++k) {
+        const Eigen::Vector2f p = c + Eigen::Vector2f(spread(rng), spread(rng));
+        if (p.x() < 0 || p.y() < 0 || p.x() >= 640 || p.y() >= 480) continue;
+        set.points.push_back(p);
+        set.cluster.push_back(-1);
+      }
+    }
+  } else {
+    for (int k = 0; k < background; ++k) {
+      set.points.emplace_back(x(rng), y(rng));
+      set.cluster.push_back(-1);
+    }
+  }
+  set.clusters = 3;
+  const int per_cluster = density == Density::sparse ? 25 : 120;
+  for (int c = 0; c < set.clusters; ++c) {
+    const float radius = 30.0f + 30.0f * unit(rng);
+    const Eigen::Vector2f centre(80.0f + 480.0f * unit(rng), 70.0f + 340.0f * unit(rng));
+    // Background points falling inside a planted disc belong to it (a disc is one object).
+    for (size_t i = 0; i < set.points.size(); ++i)
+      if ((set.points[i] - centre).norm() < radius) set.cluster[i] = c;
+    for (int k = 0; k < per_cluster; ++k) {
+      const float r = radius * std::sqrt(unit(rng)), angle = 6.2831853f * unit(rng);
+      set.points.push_back(centre + r * Eigen::Vector2f(std::cos(angle), std::sin(angle)));
+      set.cluster.push_back(c);
+    }
+  }
+  return set;
+}
+
+TEST(AntColonySearch, FindsEveryPlantedClusterTestingFewerPoints) {
+  for (Density density : {Density::sparse, Density::dense, Density::clustered}) {
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+      const PlantedSet set = make_set(density, seed);
+      std::vector<int> calls(set.points.size(), 0);
+      const PointPredicate is_dynamic = [&](int i) {
+        ++calls[i];
+        return set.cluster[i] >= 0;
+      };
+      DynamicPointSearch search;
+      const SearchResult& r = search.run(set.points, kImage, is_dynamic);
+      int planted = 0, found = 0;
+      std::vector<int> found_per_cluster(set.clusters, 0);
+      for (size_t i = 0; i < set.points.size(); ++i) {
+        EXPECT_LE(calls[i], 1) << "a point was tested twice";
+        if (set.cluster[i] < 0) {
+          EXPECT_FALSE(r.dynamic[i]);
+          continue;
+        }
+        ++planted;
+        if (r.dynamic[i]) {
+          ++found;
+          ++found_per_cluster[set.cluster[i]];
+        }
+      }
+      const std::string where =
+          "density " + std::to_string(static_cast<int>(density)) + " seed " + std::to_string(seed);
+      for (int c = 0; c < set.clusters; ++c) EXPECT_GT(found_per_cluster[c], 0) << where;
+      // Sparse discs have gaps near the band width, so a few rim points may stay untested.
+      EXPECT_GE(found, (density == Density::sparse ? 0.9 : 0.97) * planted) << where;
+      // Planted discs cover up to a third of the image with their bands; the path alone ~40%.
+      EXPECT_LT(r.tested_count, 0.7 * static_cast<double>(set.points.size())) << where;
+      EXPECT_EQ(r.dynamic_count, found);
+
+      DynamicPointSearch exhaustive(AntColonyParams{.strategy = SearchStrategy::exhaustive});
+      const SearchResult& all = exhaustive.run(set.points, kImage, [&](int i) {
+        return set.cluster[i] >= 0;
+      });
+      EXPECT_EQ(all.tested_count, static_cast<int>(set.points.size()));
+      EXPECT_EQ(all.dynamic_count, planted);
+    }
+  }
+}
+
+TEST(AntColonySearch, TerminatesOnAdversarialSets) {
+  DynamicPointSearch search;
+  const auto always = [](int) { return true; };
+  // Everything dynamic, dense: one community swallows the image; each round adds >= 1 point.
+  std::vector<Eigen::Vector2f> grid;
+  for (int y = 0; y < 480; y += 8)
+    for (int x = 0; x < 640; x += 8) grid.emplace_back(x, y);
+  const SearchResult& all = search.run(grid, kImage, always);
+  EXPECT_EQ(all.tested_count, static_cast<int>(grid.size()));
+  EXPECT_EQ(all.dynamic_count, static_cast<int>(grid.size()));
+  EXPECT_LE(all.band_rounds, static_cast<int>(grid.size()) + all.communities);
+
+  // Collinear points: the hull degenerates to a segment.
+  std::vector<Eigen::Vector2f> line;
+  for (int k = 0; k < 200; ++k) line.emplace_back(3.0f * k, 20.0f + 2.0f * k);
+  const SearchResult& on_line = search.run(line, kImage, always);
+  EXPECT_EQ(on_line.dynamic_count, 200);
+
+  // A single point, and many copies of one point (hull of one vertex), both on path nodes
+  // (lanes at y = 24 + 48 k, nodes at x = 8 + 16 k).
+  const std::vector<Eigen::Vector2f> one = {{104.0f, 72.0f}};
+  EXPECT_EQ(search.run(one, kImage, always).dynamic_count, 1);
+  const std::vector<Eigen::Vector2f> copies(50, Eigen::Vector2f(296.0f, 120.0f));
+  EXPECT_EQ(search.run(copies, kImage, always).dynamic_count, 50);
+  EXPECT_EQ(search.run({}, kImage, always).tested_count, 0);
+
+  // A round cap is honoured even when every round finds something.
+  AntColonyParams capped;
+  capped.max_band_rounds = 3;
+  capped.band_width_px = 5.0f;
+  DynamicPointSearch small_rounds(capped);
+  const SearchResult& c = small_rounds.run(line, kImage, always);
+  EXPECT_LE(c.band_rounds, 3 * c.communities);
+}
+
+TEST(AntColonySearch, PriorityPointsSeedCommunities) {
+  // A lone dynamic cluster between lanes is missed by the path but found from a priority seed
+  // (the previous frame's mask warped by the compensated homography).
+  std::vector<Eigen::Vector2f> points;
+  std::vector<int> dynamic_ids;
+  for (int k = 0; k < 10; ++k) {
+    points.emplace_back(300.0f + 2.0f * k, 48.0f);  // exactly between lanes at y=24 and y=72
+    dynamic_ids.push_back(k);
+  }
+  const auto is_dynamic = [](int i) { return i < 10; };
+  DynamicPointSearch search;
+  EXPECT_EQ(search.run(points, kImage, is_dynamic).dynamic_count, 0);
+  const std::vector<int> priority = {4};
+  EXPECT_EQ(search.run(points, kImage, is_dynamic, priority).dynamic_count, 10);
+}
+
+TEST(ConvexHull, DegenerateAndDistance) {
+  std::vector<Eigen::Vector2f> scratch, hull;
+  const std::vector<Eigen::Vector2f> square = {{0, 0}, {10, 0}, {10, 10}, {0, 10}, {5, 5}, {5, 0}};
+  convex_hull(square, scratch, hull);
+  EXPECT_EQ(hull.size(), 4u);
+  EXPECT_FLOAT_EQ(distance_to_convex_hull(hull, {5, 5}), 0.0f);
+  EXPECT_FLOAT_EQ(distance_to_convex_hull(hull, {13, 14}), 5.0f);
+  const std::vector<Eigen::Vector2f> line = {{0, 0}, {1, 1}, {2, 2}, {3, 3}};
+  convex_hull(line, scratch, hull);
+  EXPECT_EQ(hull.size(), 2u);
+  EXPECT_NEAR(distance_to_convex_hull(hull, {0, 2}), std::sqrt(2.0f), 1e-6);
+}
+
+TEST(AntColonySearch, ParamsFromYaml) {
+  const YAML::Node node = YAML::Load("strategy: exhaustive\nsearch_radius_px: 10\n");
+  YamlSection section(node, "c.yaml", "geometry.search");
+  const AntColonyParams p = AntColonyParams::from_yaml(section);
+  EXPECT_EQ(p.strategy, SearchStrategy::exhaustive);
+  EXPECT_FLOAT_EQ(p.search_radius_px, 10.0f);
+  const YAML::Node bad = YAML::Load("strategy: random\n");
+  YamlSection bad_section(bad, "c.yaml", "geometry.search");
+  try {
+    AntColonyParams::from_yaml(bad_section);
+    FAIL() << "expected Error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "c.yaml: key 'geometry.search.strategy' must be ant_colony or exhaustive, not "
+                 "'random'");
+  }
+  const YAML::Node zero = YAML::Load("band_width_px: 0\n");
+  YamlSection zero_section(zero, "c.yaml", "geometry.search");
+  EXPECT_THROW(AntColonyParams::from_yaml(zero_section), Error);
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -1,0 +1,124 @@
+#include <gtest/gtest.h>
+
+#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/error.h"
+#include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/geometry/synthetic_scene.h"
+
+namespace pspslam {
+namespace {
+
+PinholeCamera small_camera() {
+  PinholeCamera c;
+  c.width = 320;
+  c.height = 240;
+  c.fx = c.fy = 262.5;
+  c.cx = 159.5;
+  c.cy = 119.5;
+  return c;
+}
+
+struct Rendered {
+  cv::Mat depth, labels;
+};
+
+TEST(GeometryStage, DetectsPeopleAndCarriedBoxInSyntheticScene) {
+  SyntheticSceneParams scene_params;
+  scene_params.camera = small_camera();
+  scene_params.seed = 3;
+  const SyntheticScene scene(scene_params);
+  const int current = 40;
+  std::vector<DepthView> references;
+  std::vector<Rendered> keep;
+  for (int frame = current - 10; frame >= current - 30; frame -= 10) {
+    Rendered r;
+    scene.render(frame, r.depth, r.labels);
+    references.push_back({scene.camera_pose(frame), r.depth});
+    keep.push_back(r);
+  }
+  Rendered now;
+  scene.render(current, now.depth, now.labels);
+  const std::vector<Eigen::Vector2d> keypoints = sample_candidate_pixels(now.depth, 600, 11);
+
+  GeometryParams params;
+  params.search.search_radius_px = 6.0f;  // half-resolution image: half the pixel distances
+  params.search.node_spacing_px = 8.0f;
+  params.search.lane_spacing_px = 24.0f;
+  params.search.band_width_px = 10.0f;
+  GeometryStage stage(scene_params.camera, params);
+  GeometryFrameInput input;
+  input.depth = now.depth;
+  input.T_world_camera = scene.camera_pose(current);
+  input.keypoints = keypoints;
+  input.references = references;
+  const GeometryFrameResult result = stage.process(input);
+
+  int true_positive = 0, false_positive = 0, false_negative = 0, carried = 0, carried_found = 0;
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const int label = now.labels.at<std::uint8_t>(static_cast<int>(keypoints[i].y()),
+                                                  static_cast<int>(keypoints[i].x()));
+    const bool dynamic = label != 0;
+    if (label == 100) {
+      ++carried;
+      carried_found += result.keypoint_dynamic[i];
+    }
+    if (dynamic && result.keypoint_dynamic[i]) ++true_positive;
+    if (!dynamic && result.keypoint_dynamic[i]) ++false_positive;
+    if (dynamic && !result.keypoint_dynamic[i]) ++false_negative;
+  }
+  ASSERT_GT(true_positive + false_negative, 20);
+  const double recall = static_cast<double>(true_positive) / (true_positive + false_negative);
+  const double precision = static_cast<double>(true_positive) / (true_positive + false_positive);
+  EXPECT_GE(recall, 0.9);
+  EXPECT_GE(precision, 0.9);
+  if (carried > 0) {
+    EXPECT_GE(carried_found, carried * 0.8);
+  }
+  EXPECT_LT(result.tested_count, static_cast<int>(keypoints.size()));
+  EXPECT_EQ(result.dynamic_mask.type(), CV_8UC1);
+  EXPECT_EQ(result.dynamic_mask.size(), now.depth.size());
+  EXPECT_GT(result.timing.total_ms, 0.0);
+}
+
+TEST(GeometryStage, FuseMasksIsDilatedOr) {
+  cv::Mat semantic = cv::Mat::zeros(100, 100, CV_8UC1), geometry = semantic.clone();
+  semantic.at<std::uint8_t>(10, 10) = 15;  // label values count as dynamic
+  geometry.at<std::uint8_t>(80, 80) = 255;
+  const cv::Mat fused = fuse_dynamic_masks(semantic, geometry, 2);
+  EXPECT_EQ(fused.at<std::uint8_t>(10, 10), 255);
+  EXPECT_EQ(fused.at<std::uint8_t>(12, 10), 255);
+  EXPECT_EQ(fused.at<std::uint8_t>(80, 82), 255);
+  EXPECT_EQ(fused.at<std::uint8_t>(50, 50), 0);
+  EXPECT_EQ(fused.at<std::uint8_t>(10, 13), 0);
+  EXPECT_EQ(cv::countNonZero(fuse_dynamic_masks(cv::Mat(), geometry, 0)), 1);
+  try {
+    fuse_dynamic_masks(semantic, cv::Mat::zeros(50, 50, CV_8UC1), 0);
+    FAIL() << "expected Error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "fuse_dynamic_masks: semantic mask 100x100 and geometry mask 50x50 differ in size");
+  }
+}
+
+TEST(GeometryStage, ParamsFromYamlReadsSubsections) {
+  const YAML::Node node = YAML::Load(
+      "homography: {inlier_threshold_px: 3}\nsearch: {strategy: exhaustive}\n"
+      "region: {stride: 4}\nprevious_mask_prior: false\n");
+  YamlSection section(node, "s.yaml", "geometry");
+  const GeometryParams p = GeometryParams::from_yaml(section);
+  EXPECT_DOUBLE_EQ(p.homography.inlier_threshold_px, 3.0);
+  EXPECT_EQ(p.search.strategy, SearchStrategy::exhaustive);
+  EXPECT_EQ(p.region.stride, 4);
+  EXPECT_FALSE(p.previous_mask_prior);
+  const YAML::Node bad = YAML::Load("region: {strid: 4}\n");
+  YamlSection bad_section(bad, "s.yaml", "geometry");
+  try {
+    GeometryParams::from_yaml(bad_section);
+    FAIL() << "expected Error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "s.yaml:1: unknown key 'geometry.region.strid'");
+  }
+}
+
+}  // namespace
+}  // namespace pspslam

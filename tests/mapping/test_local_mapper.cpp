@@ -1,0 +1,155 @@
+#include "pspslam/mapping/local_mapper.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "mapping/synthetic_world.h"
+
+namespace pspslam {
+namespace {
+
+using testing::SyntheticWorld;
+
+// Every live map point is where its observing keyframes say it is, and vice versa.
+void expect_consistent(const Map& map) {
+  std::set<std::uint64_t> live_points;
+  for (const auto& point : map.map_points()) {
+    EXPECT_FALSE(point->is_bad()) << "bad point " << point->id() << " left in the map";
+    live_points.insert(point->id());
+    for (const auto& [keyframe_id, observation] : point->observations()) {
+      const auto keyframe = observation.keyframe.lock();
+      ASSERT_TRUE(keyframe);
+      EXPECT_EQ(keyframe->map_point(observation.keypoint_index), point)
+          << "point " << point->id() << " in keyframe " << keyframe_id;
+    }
+  }
+  for (const auto& keyframe : map.keyframes()) {
+    for (const auto& point : keyframe->map_points()) {
+      if (point) EXPECT_TRUE(live_points.contains(point->id())) << "dangling " << point->id();
+    }
+  }
+}
+
+struct PathRun {
+  std::shared_ptr<Map> map = std::make_shared<Map>();
+  std::vector<Pose> truth;
+  std::vector<Pose> initial;
+  std::vector<int> transient_points;  // world indices of features seen once
+  LocalMappingStats stats;
+};
+
+// Eight keyframes along a path; poses after the first perturbed by 0.5° / 3 cm as a drifting
+// tracker would give them; 30 transient close features in each keyframe.
+PathRun run_path(SyntheticWorld& world, int num_keyframes) {
+  PathRun run;
+  LocalMappingOptions options;
+  LocalMapper mapper(run.map, options);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> pixel_x(40.0, 600.0), pixel_y(40.0, 440.0);
+  for (int k = 0; k < num_keyframes; ++k) {
+    run.truth.push_back(testing::path_pose(k));
+    run.initial.push_back(k == 0 ? run.truth[k] : testing::perturbed(run.truth[k], 0.0087, 0.03, rng));
+    for (int t = 0; t < 30; ++t) {
+      const Eigen::Vector3d in_camera =
+          world.camera()->pinhole.unproject({pixel_x(rng), pixel_y(rng)}, 2.0);
+      run.transient_points.push_back(
+          world.add_transient_point(run.truth[k].inverse() * in_camera, k));
+    }
+    const auto keyframe = world.make_keyframe(k, run.truth[k], run.initial[k], *run.map);
+    mapper.process(keyframe);
+  }
+  run.stats = mapper.stats();
+  return run;
+}
+
+TEST(LocalMapper, BuildsCullsAndOptimisesASyntheticMap) {
+  SyntheticWorld world(900, 0.35, 21);
+  const int num_keyframes = 8;
+  PathRun run = run_path(world, num_keyframes);
+
+  EXPECT_EQ(run.stats.keyframes_processed, static_cast<std::uint64_t>(num_keyframes));
+  EXPECT_GT(run.stats.points_from_depth, 300u);
+  EXPECT_GT(run.stats.points_triangulated, 50u);
+  EXPECT_GE(run.stats.bundle_adjustments, static_cast<std::uint64_t>(num_keyframes - 2));
+  EXPECT_GT(run.stats.points_culled, 0u);
+  expect_consistent(*run.map);
+
+  // Transient features older than the culling span are gone from the map.
+  std::set<int> mapped_world_points;
+  for (const auto& point : run.map->map_points()) {
+    mapped_world_points.insert(world.world_index(*point));
+  }
+  int stale_transients = 0;
+  for (int k = 0; k + 2 < num_keyframes; ++k) {
+    for (int t = 0; t < 30; ++t) stale_transients += mapped_world_points.contains(run.transient_points[k * 30 + t]);
+  }
+  EXPECT_EQ(stale_transients, 0);
+
+  // Triangulated points (world points without depth) sit where the world has them.
+  std::vector<double> errors;
+  for (const auto& point : run.map->map_points()) {
+    const int w = world.world_index(*point);
+    if (w < 0 || world.points()[w].has_depth) continue;
+    errors.push_back((point->position() - world.points()[w].position).norm());
+  }
+  ASSERT_GT(errors.size(), 50u);
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.05);
+
+  // Local BA pulled the drifted keyframes back towards the truth.
+  double error_before = 0.0, error_after = 0.0;
+  int compared = 0;
+  for (const auto& keyframe : run.map->keyframes()) {
+    const auto k = keyframe->id();
+    if (k == 0) continue;
+    error_before += testing::center_error(run.initial[k], run.truth[k]);
+    error_after += testing::center_error(keyframe->T_camera_world(), run.truth[k]);
+    ++compared;
+  }
+  ASSERT_GT(compared, 0);
+  EXPECT_LT(error_after, 0.3 * error_before)
+      << "mean centre error " << error_before / compared << " -> " << error_after / compared;
+  EXPECT_LT(error_after / compared, 0.01);
+}
+
+TEST(LocalMapper, CullsRedundantKeyframes) {
+  SyntheticWorld world(600, 0.0, 22);
+  auto map = std::make_shared<Map>();
+  LocalMapper mapper(map, LocalMappingOptions{});
+  const int num_keyframes = 7;
+  for (int k = 0; k < num_keyframes; ++k) {
+    // Nearly the same view each time: every keyframe's points are seen by all the others.
+    const Pose pose = testing::path_pose(k, 0.01, 0.001);
+    mapper.process(world.make_keyframe(k, pose, pose, *map));
+  }
+  EXPECT_GT(mapper.stats().keyframes_culled, 0u);
+  EXPECT_EQ(map->num_keyframes() + mapper.stats().keyframes_culled,
+            static_cast<size_t>(num_keyframes));
+  EXPECT_TRUE(map->keyframe(0)) << "the anchor keyframe is never culled";
+  expect_consistent(*map);
+}
+
+TEST(LocalMapper, FirstKeyframeCreatesPointsFromDepthOnly) {
+  SyntheticWorld world(400, 0.5, 23);
+  auto map = std::make_shared<Map>();
+  LocalMapper mapper(map, LocalMappingOptions{});
+  const Pose pose = testing::path_pose(0);
+  const auto keyframe = world.make_keyframe(0, pose, pose, *map);
+  mapper.process(keyframe);
+  EXPECT_EQ(map->num_keyframes(), 1u);
+  EXPECT_EQ(mapper.stats().points_triangulated, 0u);
+  EXPECT_EQ(mapper.stats().bundle_adjustments, 0u);
+  EXPECT_EQ(map->num_map_points(), mapper.stats().points_from_depth);
+  EXPECT_GT(map->num_map_points(), 100u);
+  for (const auto& point : map->map_points()) {
+    const int w = world.world_index(*point);
+    ASSERT_GE(w, 0);
+    EXPECT_TRUE(world.points()[w].has_depth);
+    EXPECT_LT((point->position() - world.points()[w].position).norm(), 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -1,0 +1,100 @@
+#include "pspslam/optimize/pose_manifold.h"
+
+#include <gtest/gtest.h>
+
+#include "optimize/synthetic_views.h"
+#include "pspslam/optimize/reprojection_error.h"
+
+namespace pspslam {
+namespace {
+
+TEST(PoseManifold, PlusThenMinusRoundTrips) {
+  const PoseManifold manifold;
+  const PoseParameters x =
+      PoseParameters::from_pose(testing::make_pose({0.3, -0.2, 0.1}, {1.0, -2.0, 0.5}));
+  const Eigen::Matrix<double, 6, 1> delta =
+      (Eigen::Matrix<double, 6, 1>() << 0.05, -0.02, 0.03, 0.1, 0.2, -0.3).finished();
+  PoseParameters y;
+  ASSERT_TRUE(manifold.Plus(x.data(), delta.data(), y.data()));
+  Eigen::Matrix<double, 6, 1> recovered;
+  ASSERT_TRUE(manifold.Minus(y.data(), x.data(), recovered.data()));
+  EXPECT_LT((recovered - delta).norm(), 1e-12);
+}
+
+TEST(PoseManifold, PlusIsLeftMultiplication) {
+  const PoseManifold manifold;
+  const Pose pose = testing::make_pose({0.3, -0.2, 0.1}, {1.0, -2.0, 0.5});
+  const PoseParameters x = PoseParameters::from_pose(pose);
+  const Eigen::Vector3d omega(0.1, 0.0, -0.2);
+  const Eigen::Vector3d v(0.3, -0.1, 0.2);
+  const Eigen::Matrix<double, 6, 1> delta = (Eigen::Matrix<double, 6, 1>() << omega, v).finished();
+  PoseParameters y;
+  ASSERT_TRUE(manifold.Plus(x.data(), delta.data(), y.data()));
+  const Pose expected = testing::make_pose(omega, v) * pose;
+  EXPECT_TRUE(y.to_pose().isApprox(expected, 1e-12));
+}
+
+// The analytic tangent Jacobians of both residual kinds against central differences through Plus.
+template <int kResiduals>
+void check_bundle_jacobians() {
+  const PinholeCamera camera = testing::test_camera();
+  const StereoProjection model = StereoProjection::from(camera, testing::test_bf(camera));
+  const PoseManifold manifold;
+  const PoseParameters pose =
+      PoseParameters::from_pose(testing::make_pose({0.2, 0.1, -0.1}, {0.1, 0.2, 0.3}));
+  Eigen::Vector3d point = pose.to_pose().inverse() * Eigen::Vector3d(0.4, -0.3, 2.0);
+  Measurement<kResiduals> measured;
+  measured.setConstant(300.0);
+  const BundleReprojectionCost<kResiduals> cost(model, measured, 1.0 / 1.2);
+
+  Eigen::Matrix<double, kResiduals, 1> residual;
+  Eigen::Matrix<double, kResiduals, 7, Eigen::RowMajor> pose_jacobian;
+  Eigen::Matrix<double, kResiduals, 3, Eigen::RowMajor> point_jacobian;
+  const double* parameters[] = {pose.data(), point.data()};
+  double* jacobians[] = {pose_jacobian.data(), point_jacobian.data()};
+  ASSERT_TRUE(cost.Evaluate(parameters, residual.data(), jacobians));
+  EXPECT_EQ(pose_jacobian.col(6).norm(), 0.0);
+
+  const double step = 1e-6;
+  for (int j = 0; j < 6; ++j) {
+    Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
+    delta(j) = step;
+    PoseParameters plus, minus;
+    manifold.Plus(pose.data(), delta.data(), plus.data());
+    delta(j) = -step;
+    manifold.Plus(pose.data(), delta.data(), minus.data());
+    Eigen::Matrix<double, kResiduals, 1> r_plus, r_minus;
+    const double* p_plus[] = {plus.data(), point.data()};
+    const double* p_minus[] = {minus.data(), point.data()};
+    cost.Evaluate(p_plus, r_plus.data(), nullptr);
+    cost.Evaluate(p_minus, r_minus.data(), nullptr);
+    const Eigen::Matrix<double, kResiduals, 1> numeric = (r_plus - r_minus) / (2.0 * step);
+    EXPECT_LT((numeric - pose_jacobian.col(j)).norm(), 1e-4) << "pose tangent column " << j;
+  }
+  for (int j = 0; j < 3; ++j) {
+    Eigen::Vector3d plus = point, minus = point;
+    plus(j) += step;
+    minus(j) -= step;
+    Eigen::Matrix<double, kResiduals, 1> r_plus, r_minus;
+    const double* p_plus[] = {pose.data(), plus.data()};
+    const double* p_minus[] = {pose.data(), minus.data()};
+    cost.Evaluate(p_plus, r_plus.data(), nullptr);
+    cost.Evaluate(p_minus, r_minus.data(), nullptr);
+    const Eigen::Matrix<double, kResiduals, 1> numeric = (r_plus - r_minus) / (2.0 * step);
+    EXPECT_LT((numeric - point_jacobian.col(j)).norm(), 1e-4) << "point column " << j;
+  }
+}
+
+TEST(ReprojectionError, MonocularJacobiansMatchFiniteDifferences) { check_bundle_jacobians<2>(); }
+
+TEST(ReprojectionError, RgbdJacobiansMatchFiniteDifferences) { check_bundle_jacobians<3>(); }
+
+TEST(ReprojectionError, PointBehindCameraIsRejected) {
+  const PinholeCamera camera = testing::test_camera();
+  const StereoProjection model = StereoProjection::from(camera, testing::test_bf(camera));
+  EXPECT_TRUE(std::isinf(
+      chi_squared<2>(model, Eigen::Vector2d(320.0, 240.0), 1.0, Eigen::Vector3d(0.0, 0.0, -1.0))));
+}
+
+}  // namespace
+}  // namespace pspslam

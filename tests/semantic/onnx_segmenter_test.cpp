@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <fstream>
+
+#include "pspslam/core/error.h"
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/semantic/onnx_segmenter.h"
+#include "support/test_support.h"
+
+namespace pspslam {
+namespace {
+
+const std::filesystem::path kModelDir = source_dir() / "models" / "pspnet";
+
+std::vector<int> validation_ids() {
+  const YAML::Node split = YAML::LoadFile((kModelDir / "human_seg_split.json").string());
+  return split["val"].as<std::vector<int>>();
+}
+
+// Person IoU of `segmenter` on a human_seg photo (mask resized to the photo, nearest).
+double person_iou(Segmenter& segmenter, const std::filesystem::path& shared, int id) {
+  const auto root = shared / "data" / "human_seg";
+  const cv::Mat bgr = cv::imread((root / "images" / (std::to_string(id) + ".jpg")).string());
+  cv::Mat gt = cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(),
+                          cv::IMREAD_GRAYSCALE);
+  EXPECT_FALSE(bgr.empty() || gt.empty()) << "human_seg sample " << id;
+  if (gt.size() != bgr.size()) cv::resize(gt, gt, bgr.size(), 0, 0, cv::INTER_NEAREST);
+  const cv::Mat pred = segmenter.segment(bgr) == 15;
+  const cv::Mat truth = gt > 127;
+  const double inter = cv::countNonZero(pred & truth);
+  const double uni = cv::countNonZero(pred | truth);
+  return uni == 0 ? 1.0 : inter / uni;
+}
+
+TEST(OnnxSegmenter, MatchesTheLogitsRecordedAtExport) {
+  OnnxSegmenter segmenter(load_segmenter_metadata(kModelDir / "pspnet.yaml"));
+  const cv::Mat input = cv::imread((kModelDir / "golden" / "input.png").string());
+  ASSERT_FALSE(input.empty());
+  const cv::Mat& logits = segmenter.logits(input);
+  ASSERT_EQ(logits.dims, 4);
+  std::ifstream file(kModelDir / "golden" / "logits.txt");
+  int c = 0, y = 0, x = 0, count = 0;
+  double expected = 0, worst = 0;
+  while (file >> c >> y >> x >> expected) {
+    const int idx[4] = {0, c, y, x};
+    worst = std::max(worst, std::abs(logits.at<float>(idx) - expected));
+    ++count;
+  }
+  EXPECT_GE(count, 100);
+  EXPECT_LE(worst, 1e-3);
+
+  const cv::Mat golden_labels =
+      cv::imread((kModelDir / "golden" / "labels.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(golden_labels.type(), CV_8UC1);
+  const LabelMap labels = segmenter.segment(input);
+  ASSERT_EQ(labels.size(), golden_labels.size());
+  // Exact up to arg-max ties between nearly equal logits.
+  EXPECT_LE(cv::countNonZero(labels != golden_labels), static_cast<int>(labels.total() / 1000));
+}
+
+TEST(OnnxSegmenter, LabelMapHasTheImageSizeAndDynamicClassesFromMetadata) {
+  OnnxSegmenter segmenter(load_segmenter_metadata(kModelDir / "pspnet.yaml"));
+  const cv::Mat image(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
+  const LabelMap labels = segmenter.segment(image);
+  EXPECT_EQ(labels.type(), CV_8UC1);
+  EXPECT_EQ(labels.size(), image.size());
+  EXPECT_EQ(segmenter.default_dynamic_classes(),
+            (std::vector<int>{15, 3, 8, 10, 12, 13, 17, 1, 2, 4, 6, 7, 14, 19}));
+  EXPECT_THROW(segmenter.segment(cv::Mat(10, 10, CV_8UC1)), Error);
+}
+
+TEST(OnnxSegmenter, OutputShapeDisagreeingWithMetadataIsAnError) {
+  SegmenterMetadata meta = load_segmenter_metadata(kModelDir / "pspnet.yaml");
+  meta.output_stride = 8;
+  OnnxSegmenter segmenter(meta);
+  try {
+    segmenter.segment(cv::Mat(288, 384, CV_8UC3, cv::Scalar::all(0)));
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (kModelDir / "pspnet.yaml").string() +
+                  ": network output is 1x21x288x384, metadata says 1x21x36x48 (classes, input / "
+                  "output.stride)");
+  }
+}
+
+TEST(OnnxSegmenter, PersonIoUOnValidationPhotos) {
+  PSPSLAM_SHARED_OR_SKIP(shared);
+  OnnxSegmenter segmenter(load_segmenter_metadata(kModelDir / "pspnet.yaml"));
+  const auto ids = validation_ids();
+  ASSERT_GE(ids.size(), 40u);
+  double sum = 0;
+  const int n = 12;
+  for (int i = 0; i < n; ++i) sum += person_iou(segmenter, shared, ids[static_cast<size_t>(i)]);
+  // Measured on these 12 photos at export time: see models/pspnet/MODEL_CARD.md.
+  EXPECT_GE(sum / n, 0.80);
+}
+
+TEST(OnnxSegmenter, TeachersRunThroughTheSameClass) {
+  PSPSLAM_SHARED_OR_SKIP(shared);
+  const auto ids = validation_ids();
+  for (const char* name : {"deeplabv3_mnv2_pascal.yaml", "espnetv2_s2.0_pascal_384x384.yaml"}) {
+    OnnxSegmenter teacher(load_segmenter_metadata(source_dir() / "models" / "teachers" / name));
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) sum += person_iou(teacher, shared, ids[static_cast<size_t>(i)]);
+    EXPECT_GE(sum / 3, 0.6) << name;
+  }
+}
+
+}  // namespace
+}  // namespace pspslam

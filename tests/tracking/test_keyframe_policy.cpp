@@ -1,0 +1,47 @@
+#include <gtest/gtest.h>
+
+#include "pspslam/tracking/keyframe_policy.h"
+
+namespace pspslam {
+namespace {
+
+KeyFrameEvidence steady_tracking() {
+  KeyFrameEvidence e;
+  e.frame_id = 100;
+  e.last_keyframe_frame_id = 95;
+  e.keyframes_in_map = 10;
+  e.tracked_inliers = 400;
+  e.reference_tracked_points = 450;
+  e.tracked_close_points = 300;
+  e.untracked_close_points = 50;
+  return e;
+}
+
+TEST(KeyFramePolicy, NoKeyFrameWhileTrackingTheReferenceWell) {
+  EXPECT_EQ(decide_keyframe(steady_tracking(), {}), KeyFrameDecision::kSkip);
+}
+
+TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
+  KeyFrameEvidence e = steady_tracking();
+  e.tracked_inliers = 300;  // < 0.75 * 450, mapper idle
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  e.mapper_idle = false;
+  e.last_keyframe_frame_id = 99;
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);  // busy and not yet due
+  e.last_keyframe_frame_id = 60;                               // due: 40 > 30 frames
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
+  e.mapper_queue = 3;
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInterruptMapper);
+}
+
+TEST(KeyFramePolicy, KeyFrameWhenCloseStructureIsUntracked) {
+  KeyFrameEvidence e = steady_tracking();
+  e.tracked_close_points = 90;   // < 100 tracked close points
+  e.untracked_close_points = 80; // > 70 untracked ones
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+}
+
+}  // namespace
+}  // namespace pspslam

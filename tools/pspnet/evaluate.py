@@ -1,0 +1,56 @@
+"""Person IoU on the human_seg validation split for segmenter metadata YAMLs.
+
+Uses cv2.dnn with the same preprocessing as the C++ OnnxSegmenter (stretch to the
+network input, bilinear; (p - mean) / std; arg-max; nearest-neighbour resize back),
+as a cross-check of bench_segmentation's IoU table.
+"""
+
+import argparse
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+import common
+
+
+def load_net(meta_file):
+    meta = yaml.safe_load(Path(meta_file).read_text())
+    ref = meta["onnx"]
+    if ref.startswith("${shared}/"):
+        path = common.SHARED / ref[len("${shared}/"):]
+    else:
+        path = Path(meta_file).parent / ref
+    if meta["input"]["channel_order"] != "RGB":
+        raise ValueError("only RGB models are handled here")
+    return meta, cv2.dnn.readNetFromONNX(str(path))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("models", nargs="+", help="metadata YAML files")
+    parser.add_argument("--threads", type=int, default=2, help="OpenCV threads")
+    args = parser.parse_args()
+    cv2.setNumThreads(args.threads)
+    ids = common.load_split()["val"]
+    for meta_file in args.models:
+        meta, net = load_net(meta_file)
+        w, h = meta["input"]["width"], meta["input"]["height"]
+        ious, times = [], []
+        for sample_id in ids:
+            bgr, gt = common.load_human_seg(sample_id)
+            t0 = time.perf_counter()
+            net.setInput(common.to_blob(bgr, w, h, meta["input"]["mean"], meta["input"]["std"]))
+            labels = net.forward()[0].argmax(0).astype(np.uint8)
+            times.append(time.perf_counter() - t0)
+            labels = cv2.resize(labels, (gt.shape[1], gt.shape[0]),
+                                interpolation=cv2.INTER_NEAREST)
+            ious.append(common.person_iou(labels, gt))
+        print(f"{meta['name']:34s} {w}x{h}  person IoU {np.mean(ious):.4f} "
+              f"({len(ids)} validation photos)  median forward {1000 * np.median(times):.0f} ms")
+
+
+if __name__ == "__main__":
+    main()

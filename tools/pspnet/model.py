@@ -1,0 +1,152 @@
+"""Compact PSPNet (paper Fig. 2) on a dilated MobileNetV2 backbone.
+
+Backbone: MobileNetV2 1.0 with the strides of the last stages replaced by
+dilation (64/96-channel stages: dilation 2, 160/320-channel stages: dilation 4),
+so the final feature map is 1/8 of the input.  The backbone convolutions carry
+a bias and no batch-norm: the pretrained DeepLab v3 weights we start from have
+batch-norm folded into the convolutions already, so conv+bias reproduces them
+exactly and fine-tuning does not depend on small-batch statistics.
+
+Head: pyramid pooling module (average pooling to 1x1, 2x2, 3x3, 6x6 bins, each
+followed by 1x1 conv + BN + ReLU and bilinear upsampling), concatenated with the
+backbone features, 3x3 conv + BN + ReLU + dropout, 1x1 classifier to 21 VOC
+classes, bilinear upsampling of the logits to the input size inside the graph.
+"""
+
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+NUM_CLASSES = 21
+PERSON = 15
+
+# (expansion t, output channels c, repeats n, stride s, dilation d) per stage.
+# Original MobileNetV2 strides are 1,2,2,2,1,2,1; the last two stride-2 stages
+# become stride 1 with dilation so that the output stride is 8.
+STAGES = [
+    (1, 16, 1, 1, 1),
+    (6, 24, 2, 2, 1),
+    (6, 32, 3, 2, 1),
+    (6, 64, 4, 1, 2),
+    (6, 96, 3, 1, 2),
+    (6, 160, 3, 1, 4),
+    (6, 320, 1, 1, 4),
+]
+# Channel widths (stem, then one per stage) of MobileNetV2 1.0 and of the
+# depth-multiplier-0.5 variant used by deeplabv3_mnv2_dm05_pascal.onnx.
+WIDTHS = {
+    "1.0": (32, 16, 24, 32, 64, 96, 160, 320),
+    "0.5": (16, 8, 12, 16, 32, 48, 80, 160),
+}
+
+
+def conv_relu6(cin, cout, k, stride=1, dilation=1, groups=1):
+    pad = dilation * (k // 2)
+    return nn.Sequential(
+        nn.Conv2d(cin, cout, k, stride, pad, dilation=dilation, groups=groups, bias=True),
+        nn.ReLU6(inplace=True))
+
+
+class InvertedResidual(nn.Module):
+    def __init__(self, cin, cout, expand, stride, dilation):
+        super().__init__()
+        hidden = cin * expand
+        layers = []
+        if expand != 1:
+            layers.append(conv_relu6(cin, hidden, 1))
+        layers.append(conv_relu6(hidden, hidden, 3, stride, dilation, groups=hidden))
+        layers.append(nn.Conv2d(hidden, cout, 1, bias=True))  # linear bottleneck
+        self.body = nn.Sequential(*layers)
+        self.residual = stride == 1 and cin == cout
+
+    def forward(self, x):
+        y = self.body(x)
+        return x + y if self.residual else y
+
+
+class DilatedMobileNetV2(nn.Module):
+    """MobileNetV2 with output stride 8: stages 64/96 dilated by 2, 160/320 by 4.
+
+    (We tried running the dilated stages in a space-to-batch layout, which is
+    exact, to avoid OpenCV 4.6's slow dilated depthwise path; the 6-D
+    transposes cost more in OpenCV than they saved, so plain dilation it is.)
+    """
+
+    def __init__(self, width="1.0"):
+        super().__init__()
+        widths = WIDTHS[width]
+        self.out_channels = widths[-1]
+        layers = [conv_relu6(3, widths[0], 3, stride=2)]
+        cin = widths[0]
+        for (t, _, n, s, d), c in zip(STAGES, widths[1:]):
+            for i in range(n):
+                layers.append(InvertedResidual(cin, c, t, s if i == 0 else 1, d))
+                cin = c
+        self.features = nn.Sequential(*layers)
+
+    def forward(self, x):
+        return self.features(x)
+
+    def convs(self):
+        """All Conv2d layers in graph order (matches the DeepLab ONNX order)."""
+        return [m for m in self.features.modules() if isinstance(m, nn.Conv2d)]
+
+
+class PyramidPooling(nn.Module):
+    """PPM with bins 1, 2, 3, 6.
+
+    The bins are written as fixed-kernel average pooling (kernel = stride =
+    feature size / bins), which is what adaptive pooling equals when the
+    feature size divides by the bin count; it exports to ONNX AveragePool that
+    OpenCV 4.6 reads.  The feature size is therefore fixed at construction.
+    """
+
+    def __init__(self, cin, branch_channels, feat_hw, bins=(1, 2, 3, 6)):
+        super().__init__()
+        fh, fw = feat_hw
+        for b in bins:
+            if fh % b or fw % b:
+                raise ValueError(f"feature map {fw}x{fh} does not divide by bin {b}")
+        self.bins = bins
+        self.kernels = [(fh // b, fw // b) for b in bins]
+        self.branches = nn.ModuleList([
+            nn.Sequential(nn.Conv2d(cin, branch_channels, 1, bias=False),
+                          nn.BatchNorm2d(branch_channels), nn.ReLU(inplace=True))
+            for _ in bins])
+
+    def forward(self, x):
+        size = x.shape[-2:]
+        outs = [x]
+        for k, branch in zip(self.kernels, self.branches):
+            y = F.avg_pool2d(x, kernel_size=k, stride=k)
+            y = branch(y)
+            outs.append(F.interpolate(y, size=size, mode="bilinear", align_corners=False))
+        return torch.cat(outs, 1)
+
+
+class PSPNet(nn.Module):
+    def __init__(self, input_hw=(288, 384), width="1.0", branch_channels=64,
+                 head_channels=96, num_classes=NUM_CLASSES, dropout=0.1):
+        super().__init__()
+        h, w = input_hw
+        if h % 8 or w % 8:
+            raise ValueError("input size must divide by 8")
+        self.input_hw = input_hw
+        self.backbone = DilatedMobileNetV2(width)
+        cin = self.backbone.out_channels
+        self.ppm = PyramidPooling(cin, branch_channels, (h // 8, w // 8))
+        self.head = nn.Sequential(
+            nn.Conv2d(cin + 4 * branch_channels, head_channels, 3, padding=1, bias=False),
+            nn.BatchNorm2d(head_channels), nn.ReLU(inplace=True), nn.Dropout2d(dropout),
+            nn.Conv2d(head_channels, num_classes, 1))
+
+    def forward(self, x):
+        size = x.shape[-2:]
+        y = self.head(self.ppm(self.backbone(x)))
+        return F.interpolate(y, size=size, mode="bilinear", align_corners=False)
+
+    def param_groups(self):
+        backbone = list(self.backbone.parameters())
+        ids = {id(p) for p in backbone}
+        head = [p for p in self.parameters() if id(p) not in ids]
+        return backbone, head

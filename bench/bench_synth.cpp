@@ -56,7 +56,12 @@ void BM_SynthWriteSequence(benchmark::State& state) {
   state.counters["frames/s"] = benchmark::Counter(
       static_cast<double>(state.iterations() * options.frames), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_SynthWriteSequence)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_SynthWriteSequence)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
 

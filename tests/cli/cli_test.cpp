@@ -17,7 +17,8 @@ struct Result {
 
 Result pspslam(const std::string& arguments) {
   Result result;
-  result.status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " " + arguments, &result.output);
+  result.status =
+      testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " " + arguments, &result.output);
   return result;
 }
 
@@ -31,20 +32,25 @@ size_t count_of(const std::string& text, const std::string& part) {
   return count;
 }
 
-// 1 m/s along x for `seconds` at 30 Hz; the estimate is `speed` m/s, shifted by 2 m in y.
-void write_trajectories(const std::filesystem::path& dir, double speed, double seconds = 5.0) {
-  Trajectory gt, estimate;
-  for (int i = 0; i <= static_cast<int>(seconds * 30); ++i) {
+// Ground truth: 1 m/s along x with a z wave, 5 s at 30 Hz. est.txt: x at `speed` m/s (a pure
+// translation drift of speed - 1 m/s), shifted 2 m in y. scaled.txt: the whole ground truth
+// scaled by 1.1 (a monocular-style scale error) and shifted.
+void write_trajectories(const std::filesystem::path& dir, double speed) {
+  Trajectory gt, estimate, scaled;
+  for (int i = 0; i <= 150; ++i) {
     StampedPose p;
     p.timestamp = 200.0 + i / 30.0;
-    p.T_world_camera.translation() = Eigen::Vector3d(i / 30.0, 0.0, 0.5 * std::sin(i / 20.0));
+    const Eigen::Vector3d position(i / 30.0, 0.0, 0.5 * std::sin(i / 20.0));
+    p.T_world_camera.translation() = position;
     gt.push_back(p);
-    p.T_world_camera.translation() =
-        Eigen::Vector3d(speed * i / 30.0, 2.0, 0.5 * std::sin(i / 20.0));
+    p.T_world_camera.translation() = Eigen::Vector3d(speed * i / 30.0, 2.0, position.z());
     estimate.push_back(p);
+    p.T_world_camera.translation() = 1.1 * position + Eigen::Vector3d(0.0, 2.0, 0.0);
+    scaled.push_back(p);
   }
   write_tum_trajectory(dir / "gt.txt", gt);
   write_tum_trajectory(dir / "est.txt", estimate);
+  write_tum_trajectory(dir / "scaled.txt", scaled);
 }
 
 std::filesystem::path make_sequence(const std::string& tag, bool with_config) {
@@ -54,8 +60,10 @@ std::filesystem::path make_sequence(const std::string& tag, bool with_config) {
   std::ofstream rgb(dir / "rgb.txt"), depth(dir / "depth.txt"), gt(dir / "groundtruth.txt");
   for (int i = 0; i < 3; ++i) {
     const std::string stamp = std::to_string(10 + i) + ".5";
-    cv::imwrite((dir / "rgb" / (stamp + ".png")).string(), cv::Mat(6, 8, CV_8UC3, cv::Scalar(1, 2, 3)));
-    cv::imwrite((dir / "depth" / (stamp + ".png")).string(), cv::Mat(6, 8, CV_16UC1, cv::Scalar(5000)));
+    cv::imwrite((dir / "rgb" / (stamp + ".png")).string(),
+                cv::Mat(6, 8, CV_8UC3, cv::Scalar(1, 2, 3)));
+    cv::imwrite((dir / "depth" / (stamp + ".png")).string(),
+                cv::Mat(6, 8, CV_16UC1, cv::Scalar(5000)));
     rgb << stamp << " rgb/" << stamp << ".png\n";
     depth << stamp << " depth/" << stamp << ".png\n";
     gt << stamp << " 0 0 " << i << " 0 0 0 1\n";
@@ -71,7 +79,8 @@ std::filesystem::path make_sequence(const std::string& tag, bool with_config) {
 TEST(CliEval, MissingRequiredFlag) {
   const Result r = pspslam("eval --est x.txt");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output, "error: pspslam eval: missing required flag --gt (see 'pspslam eval --help')\n");
+  EXPECT_EQ(r.output,
+            "error: pspslam eval: missing required flag --gt (see 'pspslam eval --help')\n");
 }
 
 TEST(CliEval, UnknownFlag) {
@@ -92,7 +101,8 @@ TEST(CliEval, HelpListsFlags) {
 TEST(CliEval, BadValuesAndFiles) {
   const auto dir = testing::make_temp_dir("cli");
   write_trajectories(dir, 1.0);
-  const std::string files = " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
+  const std::string files =
+      " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
   Result r = pspslam("eval" + files + " --rpe-unit m");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.output, "error: pspslam eval: flag --rpe-unit expects 's' or 'f', got 'm'\n");
@@ -111,7 +121,8 @@ TEST(CliEval, BadValuesAndFiles) {
 TEST(CliEval, TableJsonAndPlots) {
   const auto dir = testing::make_temp_dir("cli");
   write_trajectories(dir, 1.1);  // 0.1 m/s translation drift
-  const std::string files = " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
+  const std::string files =
+      " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
   Result r = pspslam("eval" + files);
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "alignment:    SE(3), scale 1.000000")) << r.output;
@@ -120,13 +131,15 @@ TEST(CliEval, TableJsonAndPlots) {
   EXPECT_TRUE(contains(r.output, "  RPE translation rate   m/s       120     0.1000")) << r.output;
   EXPECT_TRUE(contains(r.output, "  ATE                    m         151 ")) << r.output;
 
-  r = pspslam("eval" + files + " --json --sim3 --plot " + (dir / "plots").string());
+  r = pspslam("eval --gt " + (dir / "gt.txt").string() + " --est " + (dir / "scaled.txt").string() +
+              " --json --sim3 --plot " + (dir / "plots").string());
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "\"ate\": {\"alignment\": \"sim3\", \"max_dt_s\": 0.02"))
       << r.output;
   EXPECT_TRUE(contains(r.output, "\"rpe\": {\"delta\": 1, \"delta_unit\": \"s\"")) << r.output;
-  // With scale the 1.1x copy fits exactly: ATE rmse ~ 0, printed in full precision.
+  // With scale the 1.1x copy fits exactly: scale 1/1.1 printed in full precision, ATE ~ 0.
   EXPECT_TRUE(contains(r.output, "\"scale\": 0.90909090909")) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"error_m\": {\"count\": 151, \"rmse\": ")) << r.output;
   for (const char* name : {"trajectory_top_view.png", "trajectory_top_view.svg",
                            "ate_over_time.png", "ate_over_time.svg"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "plots" / name)) << name;
@@ -165,10 +178,9 @@ TEST(CliRun, ConfigOfWrongImageSize) {
   const Result r = pspslam("run --sequence " + dir.string() + " --out " + (dir / "out").string() +
                            " --config " + (source_dir() / "config" / "bonn.yaml").string());
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.output, "error: " + (dir / "rgb" / "10.5.png").string() +
-                                     " is 8x6 but the config " +
-                                     (source_dir() / "config" / "bonn.yaml").string() +
-                                     " says camera 640x480\n"))
+  EXPECT_TRUE(contains(
+      r.output, "error: " + (dir / "rgb" / "10.5.png").string() + " is 8x6 but the config " +
+                    (source_dir() / "config" / "bonn.yaml").string() + " says camera 640x480\n"))
       << r.output;
 }
 
@@ -177,9 +189,9 @@ TEST(CliRun, BonnCrowdDevSequenceReport) {
   const auto dir = shared / "data" / "bonn_crowd_dev";
   const auto out = testing::make_temp_dir("cli");
   // One frame is enough to check what `run` reports about the input before SLAM starts.
-  const Result r = pspslam("run --max-frames 1 --sequence " + dir.string() + " --out " +
-                           out.string() + " --config " +
-                           (source_dir() / "config" / "bonn.yaml").string());
+  const Result r =
+      pspslam("run --max-frames 1 --sequence " + dir.string() + " --out " + out.string() +
+              " --config " + (source_dir() / "config" / "bonn.yaml").string());
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(count_of(r.output, "warning:"), 1u) << r.output;
   EXPECT_TRUE(contains(r.output, "warning: " + dir.string() +

@@ -136,14 +136,16 @@ TEST(Config, MissingKeys) {
   EXPECT_EQ(load_error(no_fps), no_fps.string() + ": missing key 'camera.fps'");
   const auto no_camera = write_file(dir, "orb:\n  n_features: 10\n");
   EXPECT_EQ(load_error(no_camera), no_camera.string() + ": missing key 'camera'");
-  EXPECT_EQ(load_error(dir / "absent.yaml"), (dir / "absent.yaml").string() + ": config file not found");
+  EXPECT_EQ(load_error(dir / "absent.yaml"),
+            (dir / "absent.yaml").string() + ": config file not found");
 }
 
 TEST(Config, InvalidValues) {
   const auto dir = testing::make_temp_dir("config");
   const auto text_fx = write_file(dir, replace(kValidCamera, "  fx: 500.5\n", "  fx: wide\n"));
   EXPECT_EQ(load_error(text_fx), text_fx.string() + ":5: key 'camera.fx' has an invalid value");
-  const auto negative = write_file(dir, replace(kValidCamera, "  depth_factor: 5000\n", "  depth_factor: -1\n"));
+  const auto negative =
+      write_file(dir, replace(kValidCamera, "  depth_factor: 5000\n", "  depth_factor: -1\n"));
   EXPECT_EQ(load_error(negative), negative.string() + ": key 'camera.depth_factor' must be > 0");
   const auto distortion =
       write_file(dir, replace(kValidCamera, "[0.1, -0.2, 0.001, 0.002]", "[0.1, -0.2]"));

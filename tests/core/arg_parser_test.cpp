@@ -27,8 +27,8 @@ std::string error_of(ArgParser& parser, const std::vector<std::string>& args) {
 
 TEST(ArgParser, ParsesValuesSwitchesAndDefaults) {
   ArgParser parser = make_parser();
-  ASSERT_TRUE(parser.parse({"--gt", "a.txt", "--json", "--count=7", "--images", "x", "--images",
-                            "y"}));
+  ASSERT_TRUE(
+      parser.parse({"--gt", "a.txt", "--json", "--count=7", "--images", "x", "--images", "y"}));
   EXPECT_EQ(parser.get("gt"), "a.txt");
   EXPECT_TRUE(parser.flag("json"));
   EXPECT_EQ(parser.get_int("count"), 7);
@@ -56,7 +56,8 @@ TEST(ArgParser, MissingValue) {
 
 TEST(ArgParser, SwitchGivenAValue) {
   ArgParser parser = make_parser();
-  EXPECT_EQ(error_of(parser, {"--gt", "a", "--json=1"}), "pspslam demo: flag --json takes no value");
+  EXPECT_EQ(error_of(parser, {"--gt", "a", "--json=1"}),
+            "pspslam demo: flag --json takes no value");
 }
 
 TEST(ArgParser, PositionalArgumentRejected) {

@@ -17,8 +17,8 @@ AteResult circle_result() {
     StampedPose p;
     p.timestamp = 10.0 + 0.1 * i;
     // A circle in the x-z plane with small y wobble: the top view must pick x-z.
-    p.T_world_camera.translation() = Eigen::Vector3d(std::cos(angle), 0.01 * std::sin(5 * angle),
-                                                     std::sin(angle));
+    p.T_world_camera.translation() =
+        Eigen::Vector3d(std::cos(angle), 0.01 * std::sin(5 * angle), std::sin(angle));
     gt.push_back(p);
     p.T_world_camera.translation() += Eigen::Vector3d(0.02 * std::sin(i), 0.0, 0.0);
     estimate.push_back(p);

@@ -44,8 +44,7 @@ TEST(Rpe, ConstantTranslationDrift) {
 
 TEST(Rpe, ConstantRotationDrift) {
   // Same path, estimate yaws 2 deg/s faster than the ground truth's 5 deg/s.
-  const RpeResult rpe =
-      compute_rpe(make_trajectory(0.0, 5.0), make_trajectory(0.0, 5.0, 2.0));
+  const RpeResult rpe = compute_rpe(make_trajectory(0.0, 5.0), make_trajectory(0.0, 5.0, 2.0));
   EXPECT_NEAR(rpe.rotation.rmse, 2.0, 1e-6);
   EXPECT_NEAR(rpe.rotation.median, 2.0, 1e-6);
   EXPECT_NEAR(rpe.rotation_per_second.max, 2.0, 1e-6);

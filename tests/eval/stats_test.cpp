@@ -11,7 +11,7 @@ TEST(ErrorStats, NumpySemantics) {
   const ErrorStats even = compute_error_stats({4.0, 1.0, 3.0, 2.0});
   EXPECT_EQ(even.count, 4u);
   EXPECT_DOUBLE_EQ(even.mean, 2.5);
-  EXPECT_DOUBLE_EQ(even.median, 2.5);  // mean of the two middle values
+  EXPECT_DOUBLE_EQ(even.median, 2.5);           // mean of the two middle values
   EXPECT_DOUBLE_EQ(even.std, std::sqrt(1.25));  // population std (numpy default ddof=0)
   EXPECT_DOUBLE_EQ(even.rmse, std::sqrt(30.0 / 4.0));
   EXPECT_DOUBLE_EQ(even.min, 1.0);

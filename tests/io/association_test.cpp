@@ -34,7 +34,8 @@ Pairs reference_associate(const std::vector<double>& first, const std::vector<do
     }
   }
   std::sort(candidates.begin(), candidates.end());
-  std::set<double> first_left(first.begin(), first.end()), second_left(second.begin(), second.end());
+  std::set<double> first_left(first.begin(), first.end()),
+      second_left(second.begin(), second.end());
   Pairs pairs;
   for (const auto& [difference, a, b] : candidates) {
     if (first_left.count(a) && second_left.count(b)) {
@@ -52,8 +53,7 @@ TEST(Association, GreedyByDifferenceNotNearestPerFrame) {
   // it first; rgb 1.000 then falls back to 0.985 (0.015 < 0.02). rgb 2.0 has nothing in range.
   const std::vector<double> rgb = {1.000, 1.012, 2.0};
   const std::vector<double> depth = {0.985, 1.010, 1.030};
-  EXPECT_EQ(associated_values(rgb, depth, 0.02),
-            (Pairs{{1.000, 0.985}, {1.012, 1.010}}));
+  EXPECT_EQ(associated_values(rgb, depth, 0.02), (Pairs{{1.000, 0.985}, {1.012, 1.010}}));
 }
 
 TEST(Association, EachFrameUsedOnceAndStrictWindow) {

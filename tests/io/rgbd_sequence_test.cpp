@@ -126,7 +126,8 @@ TEST(RgbdSequence, MalformedListLinesNameFileAndLine) {
             (dir / "rgb.txt").string() + ":1: expected 'timestamp filename', got 3 fields");
   write_text(dir / "rgb.txt", "10.0000 rgb/10.0000.png\n");
   write_text(dir / "depth.txt", "\n# c\nt10.005 depth/10.0050.png\n");
-  EXPECT_EQ(open_error(dir), (dir / "depth.txt").string() + ":3: timestamp 't10.005' is not a number");
+  EXPECT_EQ(open_error(dir),
+            (dir / "depth.txt").string() + ":3: timestamp 't10.005' is not a number");
   write_text(dir / "depth.txt", "10.005 depth/10.0050.png\n10.005 depth/10.1050.png\n");
   EXPECT_EQ(open_error(dir), (dir / "depth.txt").string() + ":2: timestamp 10.005 repeats line 1");
 }

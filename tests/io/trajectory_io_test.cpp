@@ -67,16 +67,19 @@ TEST(TrajectoryIo, RoundTrip) {
 
 TEST(TrajectoryIo, ReadsCommentsBlankLinesTabsAndCommas) {
   const auto dir = testing::make_temp_dir("trajectory");
-  const auto file = write_text(dir / "t.txt",
-                               "# ground truth\n\n1.5 1 2 3 0 0 0 1\n"
-                               "  \n2.5,4,5,6,0,0,0.7071068,0.7071068\r\n3.5\t0\t0\t0\t0\t0\t0\t1\n");
+  const auto file =
+      write_text(dir / "t.txt",
+                 "# ground truth\n\n1.5 1 2 3 0 0 0 1\n"
+                 "  \n2.5,4,5,6,0,0,0.7071068,0.7071068\r\n3.5\t0\t0\t0\t0\t0\t0\t1\n");
   const Trajectory trajectory = read_tum_trajectory(file);
   ASSERT_EQ(trajectory.size(), 3u);
   EXPECT_EQ(trajectory[0].timestamp, 1.5);
   EXPECT_EQ(trajectory[1].T_world_camera.translation(), Eigen::Vector3d(4, 5, 6));
   // 90 degrees about z, normalised.
   EXPECT_NEAR((trajectory[1].T_world_camera.rotation() * Eigen::Vector3d::UnitX() -
-               Eigen::Vector3d::UnitY()).norm(), 0.0, 1e-12);
+               Eigen::Vector3d::UnitY())
+                  .norm(),
+              0.0, 1e-12);
 }
 
 TEST(TrajectoryIo, MalformedLinesNameFileAndLine) {
@@ -105,7 +108,8 @@ TEST(TrajectoryIo, AcceptsRoundingOfSixDigitQuaternions) {
   const auto dir = testing::make_temp_dir("trajectory");
   // Bonn ground truth line: the printed quaternion has norm 1 - 4e-7.
   const auto file = write_text(
-      dir / "t.txt", "1548339819.89427 -0.194787 -1.44487 1.46988 0.163205 0.0885024 -0.227926 -0.955814\n");
+      dir / "t.txt",
+      "1548339819.89427 -0.194787 -1.44487 1.46988 0.163205 0.0885024 -0.227926 -0.955814\n");
   const Trajectory trajectory = read_tum_trajectory(file);
   ASSERT_EQ(trajectory.size(), 1u);
   EXPECT_NEAR(trajectory[0].T_world_camera.rotation().determinant(), 1.0, 1e-12);

@@ -42,7 +42,7 @@ std::shared_ptr<KeyFrame> SyntheticWorld::make_keyframe(std::uint64_t id,
   cv::Mat occupied(pinhole.height, pinhole.width, CV_8U, cv::Scalar(0));
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
-  std::vector<int> world_index;
+  std::vector<int> keypoint_world;
   std::normal_distribution<double> noise(0.0, 1.0);
   std::uniform_real_distribution<float> angle(0.0f, 360.0f);
   for (int i = 0; i < static_cast<int>(points_.size()); ++i) {
@@ -65,7 +65,7 @@ std::shared_ptr<KeyFrame> SyntheticWorld::make_keyframe(std::uint64_t id,
                           angle(rng_), 1.0f, 0);
     keypoints.push_back(keypoint);
     descriptors.push_back(points_[i].descriptor);
-    world_index.push_back(i);
+    keypoint_world.push_back(i);
     if (points_[i].has_depth) depth.at<float>(v, u) = static_cast<float>(point_camera.z());
   }
 
@@ -78,11 +78,11 @@ std::shared_ptr<KeyFrame> SyntheticWorld::make_keyframe(std::uint64_t id,
     const int w = world_index(*point);
     if (w >= 0) by_world.emplace(w, point);
   }
-  for (size_t k = 0; k < world_index.size(); ++k) {
-    const auto found = by_world.find(world_index[k]);
+  for (size_t k = 0; k < keypoint_world.size(); ++k) {
+    const auto found = by_world.find(keypoint_world[k]);
     if (found != by_world.end()) frame.map_points[k] = found->second;
   }
-  keypoint_world_index_[id] = world_index;
+  keypoint_world_index_[id] = keypoint_world;
   return std::make_shared<KeyFrame>(id, frame);
 }
 

@@ -27,7 +27,8 @@ void expect_consistent(const Map& map) {
   }
   for (const auto& keyframe : map.keyframes()) {
     for (const auto& point : keyframe->map_points()) {
-      if (point) EXPECT_TRUE(live_points.contains(point->id())) << "dangling " << point->id();
+      if (!point) continue;
+      EXPECT_TRUE(live_points.contains(point->id())) << "dangling " << point->id();
     }
   }
 }
@@ -142,7 +143,15 @@ TEST(LocalMapper, FirstKeyframeCreatesPointsFromDepthOnly) {
   EXPECT_EQ(mapper.stats().points_triangulated, 0u);
   EXPECT_EQ(mapper.stats().bundle_adjustments, 0u);
   EXPECT_EQ(map->num_map_points(), mapper.stats().points_from_depth);
-  EXPECT_GT(map->num_map_points(), 100u);
+  // Every close reading becomes a point, and at least 100 readings in total (far ones too).
+  size_t close = 0, with_depth = 0;
+  for (int i = 0; i < keyframe->size(); ++i) {
+    with_depth += keyframe->depth(i) > 0.0f;
+    close += keyframe->depth(i) > 0.0f && keyframe->depth(i) <= 4.0f;
+  }
+  ASSERT_GT(close, 20u);
+  ASSERT_GT(with_depth, close);
+  EXPECT_EQ(map->num_map_points(), std::max<size_t>(close, std::min<size_t>(100, with_depth)));
   for (const auto& point : map->map_points()) {
     const int w = world.world_index(*point);
     ASSERT_GE(w, 0);

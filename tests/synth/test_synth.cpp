@@ -4,11 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <iterator>
-#include <optional>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -32,6 +33,14 @@ SynthOptions small_options(int bodies = 3) {
   options.seed = 1;
   options.threads = 2;
   return options;
+}
+
+// Building a scene (drawing ~250 textures) costs more than rendering a few frames; tests that
+// only read the default scenes share them (SyntheticScene is immutable after construction).
+const SyntheticScene& default_scene(int bodies) {
+  static const SyntheticScene with_people(small_options(3));
+  static const SyntheticScene without_people(small_options(0));
+  return bodies == 0 ? without_people : with_people;
 }
 
 double percentile(std::vector<double> values, double fraction) {
@@ -95,7 +104,7 @@ Reprojection reproject(const SyntheticScene& scene, const SynthFrame& a, const S
 }
 
 TEST(SynthScene, GroundTruthDepthAndPosesAreSelfConsistent) {
-  const SyntheticScene scene(small_options());
+  const SyntheticScene& scene = default_scene(3);
   for (const size_t start : {0u, 100u, 200u}) {
     const SynthFrame a = scene.render(start);
     for (const size_t k : {1u, 5u}) {
@@ -103,6 +112,10 @@ TEST(SynthScene, GroundTruthDepthAndPosesAreSelfConsistent) {
       const Reprojection r = reproject(scene, a, b);
       const double median = percentile(r.depth_error_m, 0.5);
       const double p95 = percentile(r.depth_error_m, 0.95);
+      std::cout << "[ stats    ] frames " << start << " -> " << start + k << ": "
+                << r.depth_error_m.size() << " points, depth error median " << median * 1e3
+                << " mm, p95 " << p95 * 1e3 << " mm; grey error median "
+                << percentile(r.grey_error, 0.5) << "\n";
       SCOPED_TRACE("frames " + std::to_string(start) + " -> " + std::to_string(start + k) + ": " +
                    std::to_string(r.depth_error_m.size()) + " points, median " +
                    std::to_string(median * 1e3) + " mm, p95 " + std::to_string(p95 * 1e3) +
@@ -127,7 +140,7 @@ TEST(SynthScene, SameSeedGivesIdenticalFramesOnAnyThreadCount) {
   SynthOptions one_thread = small_options();
   one_thread.threads = 1;
   const SyntheticScene first(one_thread);
-  const SyntheticScene second(small_options());
+  const SyntheticScene& second = default_scene(3);
   SynthOptions other_seed_options = small_options();
   other_seed_options.seed = 2;
   const SyntheticScene other_seed(other_seed_options);
@@ -164,12 +177,12 @@ TEST(SynthSequence, SameSeedWritesByteIdenticalFiles) {
     EXPECT_EQ(file_bytes(entry.path()), file_bytes(dir_b / relative)) << relative;
     ++files;
   }
-  EXPECT_EQ(files, 3u * 3u + 6u);  // rgb/depth/mask per frame; 4 lists, config, info
+  EXPECT_EQ(files, 3u * 3u + 7u);  // rgb/depth/mask per frame; 4 lists, config, info, README
 }
 
 TEST(SynthScene, StaticTwinHasNoDynamicPixelsAndMatchesTheDynamicSequence) {
-  const SyntheticScene dynamic_scene(small_options(3));
-  const SyntheticScene static_scene(small_options(0));
+  const SyntheticScene& dynamic_scene = default_scene(3);
+  const SyntheticScene& static_scene = default_scene(0);
   for (size_t index = 0; index < 300; index += 25) {
     const SynthFrame s = static_scene.render(index);
     const SynthFrame d = dynamic_scene.render(index);
@@ -188,7 +201,7 @@ TEST(SynthScene, StaticTwinHasNoDynamicPixelsAndMatchesTheDynamicSequence) {
 }
 
 TEST(SynthScene, PeopleAndTheCarriedBoxAreOftenButNotAlwaysInView) {
-  const SyntheticScene scene(small_options(3));
+  const SyntheticScene& scene = default_scene(3);
   int frames = 0, with_people = 0, with_large_people = 0, with_carried_box = 0;
   double largest_fraction = 0.0;
   SynthFrame frame;
@@ -295,7 +308,7 @@ TEST(SynthMotion, CameraMovesSmoothlyAndTheLoopRevisitsItsStart) {
 // One camera-frame cell grid count of FAST corners: ORB-SLAM needs corners everywhere.
 TEST(SynthScene, TexturesGiveCornersAllOverTheImage) {
   for (const int bodies : {0, 3}) {
-    const SyntheticScene scene(small_options(bodies));
+    const SyntheticScene& scene = default_scene(bodies);
     for (const size_t index : {0u, 120u, 240u}) {
       const SynthFrame frame = scene.render(index);
       cv::Mat grey;
@@ -311,6 +324,9 @@ TEST(SynthScene, TexturesGiveCornersAllOverTheImage) {
       for (const int count : per_cell) cells_with_corners += count >= 3;
       std::vector<cv::KeyPoint> orb_keypoints;
       cv::ORB::create(1000)->detect(grey, orb_keypoints);
+      std::cout << "[ stats    ] bodies " << bodies << " frame " << index << ": " << corners.size()
+                << " FAST corners, " << cells_with_corners << "/48 cells, " << orb_keypoints.size()
+                << " ORB keypoints\n";
       SCOPED_TRACE("bodies " + std::to_string(bodies) + " frame " + std::to_string(index) + ": " +
                    std::to_string(corners.size()) + " FAST corners, " +
                    std::to_string(cells_with_corners) + "/48 cells, " +
@@ -411,7 +427,7 @@ TEST(SynthSequence, WrittenFilesLoadBackAsTumLayout) {
 }
 
 TEST(SynthSensor, DepthNoiseGrowsWithDistanceAndHolesAreFew) {
-  const SyntheticScene noisy(small_options());
+  const SyntheticScene& noisy = default_scene(3);
   SynthOptions exact_options = small_options();
   exact_options.depth_noise = false;
   const SyntheticScene exact(exact_options);
@@ -422,7 +438,8 @@ TEST(SynthSensor, DepthNoiseGrowsWithDistanceAndHolesAreFew) {
     const SynthFrame exact_frame = exact.render(index);
     EXPECT_TRUE(same_bytes(frame.depth, exact_frame.depth));
     EXPECT_EQ(cv::countNonZero(exact_frame.depth_sensor == 0), 0);
-    EXPECT_LT(cv::norm(exact_frame.depth_sensor, exact_frame.depth, cv::NORM_INF), 1.0 / 10000 + 1e-6);
+    EXPECT_LT(cv::norm(exact_frame.depth_sensor, exact_frame.depth, cv::NORM_INF),
+              1.0 / 10000 + 1e-6);
     hole_fraction += cv::countNonZero(frame.depth_sensor == 0) / double(frame.depth.total()) / 3.0;
     for (int v = 0; v < frame.depth.rows; ++v) {
       for (int u = 0; u < frame.depth.cols; ++u) {
@@ -438,6 +455,8 @@ TEST(SynthSensor, DepthNoiseGrowsWithDistanceAndHolesAreFew) {
   }
   // sigma(z) = 1.2 mm + 1.9 mm (z - 0.4)^2: median |error| = 0.674 sigma.
   const double near_median = percentile(near_errors, 0.5), far_median = percentile(far_errors, 0.5);
+  std::cout << "[ stats    ] holes " << hole_fraction << ", median |error| at 0.8-1.5 m "
+            << near_median * 1e3 << " mm, at 3.5-4.5 m " << far_median * 1e3 << " mm\n";
   SCOPED_TRACE("holes " + std::to_string(hole_fraction) + ", median |error| near " +
                std::to_string(near_median * 1e3) + " mm, far " + std::to_string(far_median * 1e3) +
                " mm");
@@ -466,8 +485,9 @@ TEST(SynthOptions, InvalidValuesAreRejectedNamingTheFlag) {
   options.frames = 0;
   EXPECT_NE(message_of([&] { options.validate(); }).find("--frames must be >= 1, got 0"),
             std::string::npos);
-  EXPECT_NE(message_of([] { parse_synth_trajectory("circle"); })
-                .find("--trajectory expects 'handheld' or 'loop', got 'circle'"),
+  EXPECT_NE(message_of([] {
+              parse_synth_trajectory("circle");
+            }).find("--trajectory expects 'handheld' or 'loop', got 'circle'"),
             std::string::npos);
   EXPECT_EQ(parse_synth_trajectory("loop"), SynthTrajectory::kLoop);
   SynthOptions two_frames;

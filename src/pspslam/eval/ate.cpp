@@ -13,9 +13,8 @@ namespace {
 std::vector<size_t> time_order(const Trajectory& trajectory) {
   std::vector<size_t> order(trajectory.size());
   std::iota(order.begin(), order.end(), size_t{0});
-  std::sort(order.begin(), order.end(), [&](size_t l, size_t r) {
-    return trajectory[l].timestamp < trajectory[r].timestamp;
-  });
+  std::sort(order.begin(), order.end(),
+            [&](size_t l, size_t r) { return trajectory[l].timestamp < trajectory[r].timestamp; });
   return order;
 }
 
@@ -59,8 +58,9 @@ AteResult compute_ate(const Trajectory& ground_truth, const Trajectory& estimate
     char window[32];
     std::snprintf(window, sizeof(window), "%g", options.max_difference);
     throw Error("ATE: only " + std::to_string(matches.size()) + " of the " +
-                std::to_string(estimate.size()) + " estimated poses have a ground-truth pose within " +
-                window + " s (need at least 3); wrong files, or do the timestamps need --offset?");
+                std::to_string(estimate.size()) +
+                " estimated poses have a ground-truth pose within " + window +
+                " s (need at least 3); wrong files, or do the timestamps need --offset?");
   }
   Eigen::Matrix3Xd gt_xyz(3, matches.size());
   Eigen::Matrix3Xd est_xyz(3, matches.size());

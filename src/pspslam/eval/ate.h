@@ -41,12 +41,12 @@ struct AtePair {
   Timestamp est_timestamp = 0.0;
   Eigen::Vector3d gt_position = Eigen::Vector3d::Zero();
   Eigen::Vector3d est_aligned = Eigen::Vector3d::Zero();  // estimate after alignment
-  double error = 0.0;                                      // |est_aligned - gt_position|, m
+  double error = 0.0;                                     // |est_aligned - gt_position|, m
 };
 
 struct AteResult {
-  ErrorStats error;     // metres, over `pairs`
-  Alignment alignment;  // estimate -> ground-truth frame
+  ErrorStats error;            // metres, over `pairs`
+  Alignment alignment;         // estimate -> ground-truth frame
   std::vector<AtePair> pairs;  // sorted by ground-truth timestamp
   // Every estimated position after alignment and every ground-truth position, in time order
   // (plots show the whole trajectories, not only the associated pairs).

@@ -66,8 +66,8 @@ Layout make_layout(const LinePlot& plot) {
   x_min -= x_pad, x_max += x_pad, y_min -= y_pad, y_max += y_pad;
   if (plot.equal_aspect) {
     // Widen the tighter axis so that one data unit spans the same number of pixels on both.
-    const double scale = std::min(layout.frame_width() / (x_max - x_min),
-                                  layout.frame_height() / (y_max - y_min));
+    const double scale =
+        std::min(layout.frame_width() / (x_max - x_min), layout.frame_height() / (y_max - y_min));
     const double x_center = 0.5 * (x_min + x_max), y_center = 0.5 * (y_min + y_max);
     const double x_half = 0.5 * layout.frame_width() / scale;
     const double y_half = 0.5 * layout.frame_height() / scale;
@@ -92,11 +92,21 @@ std::string escape_xml(const std::string& text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c; break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+        break;
     }
   }
   return out;
@@ -145,8 +155,10 @@ std::string plot_to_svg(const LinePlot& plot) {
          "\" fill=\"none\" stroke=\"black\"/>\n";
   for (const PlotSeries& s : plot.series) {
     if (s.points.empty()) continue;
-    svg += "<polyline fill=\"none\" stroke=\"" + svg_colour(s) + "\" stroke-width=\"1.5\" points=\"";
-    for (const Eigen::Vector2d& p : s.points) svg += number(L.px(p.x())) + "," + number(L.py(p.y())) + " ";
+    svg +=
+        "<polyline fill=\"none\" stroke=\"" + svg_colour(s) + "\" stroke-width=\"1.5\" points=\"";
+    for (const Eigen::Vector2d& p : s.points)
+      svg += number(L.px(p.x())) + "," + number(L.py(p.y())) + " ";
     svg += "\"/>\n";
   }
   // Title, axis labels, legend.
@@ -157,9 +169,18 @@ std::string plot_to_svg(const LinePlot& plot) {
          "</text>\n";
   svg += "<text transform=\"translate(24," + number(L.top + L.frame_height() / 2) +
          ") rotate(-90)\" text-anchor=\"middle\">" + escape_xml(plot.y_label) + "</text>\n";
-  double legend_y = L.top + 18;
+  // Legend box in the top-right corner; text width estimated at 7.5 px per character (13 px font).
+  size_t longest = 0;
+  for (const PlotSeries& s : plot.series) longest = std::max(longest, s.label.size());
+  const double box_width = 7.5 * static_cast<double>(longest) + 56;
+  const double box_height = 20.0 * static_cast<double>(plot.series.size()) + 8;
+  const double box_x = L.left + L.frame_width() - box_width - 8, box_y = L.top + 8;
+  svg += "<rect x=\"" + number(box_x) + "\" y=\"" + number(box_y) + "\" width=\"" +
+         number(box_width) + "\" height=\"" + number(box_height) +
+         "\" fill=\"white\" stroke=\"#969696\"/>\n";
+  double legend_y = box_y + 20;
   for (const PlotSeries& s : plot.series) {
-    const double x = L.left + L.frame_width() - 200;
+    const double x = box_x + 8;
     svg += "<line x1=\"" + number(x) + "\" y1=\"" + number(legend_y - 4) + "\" x2=\"" +
            number(x + 30) + "\" y2=\"" + number(legend_y - 4) + "\" stroke=\"" + svg_colour(s) +
            "\" stroke-width=\"3\"/>\n";
@@ -182,7 +203,8 @@ void write_plot_png(const LinePlot& plot, const std::filesystem::path& file) {
   const Layout L = make_layout(plot);
   cv::Mat image(plot.height, plot.width, CV_8UC3, cv::Scalar(255, 255, 255));
   const auto at = [&](double x, double y) {
-    return cv::Point(static_cast<int>(std::lround(L.px(x))), static_cast<int>(std::lround(L.py(y))));
+    return cv::Point(static_cast<int>(std::lround(L.px(x))),
+                     static_cast<int>(std::lround(L.py(y))));
   };
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const cv::Scalar black(0, 0, 0), grid(221, 221, 221);
@@ -221,7 +243,8 @@ void write_plot_png(const LinePlot& plot, const std::filesystem::path& file) {
   {
     int baseline = 0;
     const cv::Size extent = cv::getTextSize(plot.y_label, font, 0.5, 1, &baseline);
-    cv::Mat strip(extent.height + baseline + 6, extent.width + 6, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::Mat strip(extent.height + baseline + 6, extent.width + 6, CV_8UC3,
+                  cv::Scalar(255, 255, 255));
     cv::putText(strip, plot.y_label, {3, extent.height + 3}, font, 0.5, black, 1, cv::LINE_AA);
     cv::Mat rotated;
     cv::rotate(strip, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
@@ -231,9 +254,20 @@ void write_plot_png(const LinePlot& plot, const std::filesystem::path& file) {
       rotated.copyTo(image(cv::Rect(x0, y0, rotated.cols, rotated.rows)));
     }
   }
-  int legend_y = frame_top + 18;
+  // Legend: a white box in the top-right corner, sized to its longest label, drawn over the data.
+  int label_width = 0;
   for (const PlotSeries& s : plot.series) {
-    const int x = frame_right - 200;
+    int baseline = 0;
+    label_width = std::max(label_width, cv::getTextSize(s.label, font, 0.45, 1, &baseline).width);
+  }
+  const int box_width = label_width + 56;
+  const int box_height = 20 * static_cast<int>(plot.series.size()) + 8;
+  const cv::Rect box(frame_right - box_width - 8, frame_top + 8, box_width, box_height);
+  cv::rectangle(image, box, cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::rectangle(image, box, cv::Scalar(150, 150, 150), 1);
+  int legend_y = box.y + 20;
+  for (const PlotSeries& s : plot.series) {
+    const int x = box.x + 8;
     cv::line(image, {x, legend_y - 4}, {x + 30, legend_y - 4}, cv::Scalar(s.blue, s.green, s.red),
              3, cv::LINE_AA);
     put_text(s.label, {x + 38, legend_y}, 0.45, -1);

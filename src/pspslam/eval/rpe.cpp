@@ -77,7 +77,8 @@ RpeResult compute_rpe(const Trajectory& ground_truth_in, const Trajectory& estim
   }
 
   std::vector<double> gt_intervals;
-  for (size_t k = 1; k < gt_stamps.size(); ++k) gt_intervals.push_back(gt_stamps[k] - gt_stamps[k - 1]);
+  for (size_t k = 1; k < gt_stamps.size(); ++k)
+    gt_intervals.push_back(gt_stamps[k] - gt_stamps[k - 1]);
   const double gt_max_time_difference = 2.0 * median(gt_intervals);
 
   RpeResult result;

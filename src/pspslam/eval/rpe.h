@@ -25,8 +25,8 @@ struct RpePair {
 };
 
 struct RpeResult {
-  ErrorStats translation;          // m over one delta
-  ErrorStats rotation;             // degrees over one delta
+  ErrorStats translation;  // m over one delta
+  ErrorStats rotation;     // degrees over one delta
   // Each pair's error divided by the estimate's time between its two poses: drift rates that
   // compare across deltas and frame rates. Pairs with no time between them are left out.
   ErrorStats translation_per_second;  // m/s

@@ -301,7 +301,10 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
     }
   }
 
-  // Pass 2: descriptors straight into the output rows, then coordinates to level 0.
+  // Pass 2: descriptors straight into the output rows, then coordinates to level 0. The rows are
+  // reused only when `out` is their sole owner: cv::Mat assignment shares data, and a caller that
+  // kept a shallow copy of an earlier result must not see it overwritten.
+  if (out.descriptors.u != nullptr && out.descriptors.u->refcount > 1) out.descriptors.release();
   out.descriptors.create(static_cast<int>(out.keypoints.size()), kOrbDescriptorBytes, CV_8UC1);
   for (int i = 0; i < static_cast<int>(out.keypoints.size()); ++i) {
     cv::KeyPoint& keypoint = out.keypoints[i];

@@ -38,7 +38,9 @@ class OrbExtractor {
 
   // gray: CV_8UC1. ignore_mask: empty, or CV_8UC1 of gray's size where non-zero pixels are
   // ignored (dynamic regions): no keypoint is returned whose level-0 position (rounded) falls on
-  // one. `out` is overwritten; the capacity of its vector and its descriptor matrix are reused.
+  // one. `out` is overwritten: its keypoint vector keeps its capacity, and its descriptor matrix
+  // is reused whenever the keypoint count is unchanged (the usual n_features) and no other
+  // cv::Mat shares it (a kept shallow copy of an earlier result is never overwritten).
   // Throws pspslam::Error for a wrong image type or a mask of another size/type.
   void extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbFeatures& out);
 
@@ -51,8 +53,8 @@ class OrbExtractor {
   // weight of reprojection errors in optimisation and the tolerance of matching windows.
   const std::vector<float>& level_sigma2() const { return level_sigma2_; }
   const std::vector<float>& inv_level_sigma2() const { return inv_level_sigma2_; }
-  // How many of config().n_features each level aims for (geometric in 1/scale, summing to
-  // n_features): a level of half the area gets roughly half the features.
+  // How many of config().n_features each level aims for: each level gets 1/scale_factor of the
+  // previous level's share (217, 181, 151, ... for the defaults), summing to n_features.
   const std::vector<int>& features_per_level() const { return features_per_level_; }
   // Pyramid level l of the last extracted image (a view into the extractor's buffer, valid
   // until the next extract()).
@@ -62,7 +64,7 @@ class OrbExtractor {
   struct PyramidLevel {
     cv::Mat padded;          // level image plus a reflected border (descriptor patches at edges)
     cv::Mat image;           // view of padded without the border
-    cv::Mat blurred_padded;  // padded, Gaussian-smoothed: BRIEF tests are run on this
+    cv::Mat blurred_padded;  // padded, Gaussian-smoothed (outer 3 px unset): BRIEF runs on it
     cv::Mat blurred;         // view of blurred_padded without the border
   };
 

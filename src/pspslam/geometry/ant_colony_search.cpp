@@ -59,6 +59,10 @@ void DynamicPointSearch::build_grid(std::span<const Eigen::Vector2f> points, cv:
   }
   for (size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_points_.resize(points.size());
+  // Untested points per cell: cells a community has exhausted are skipped without a look at
+  // their points in later band rounds and path nodes.
+  cell_untested_.resize(cells);
+  for (size_t c = 0; c < cells; ++c) cell_untested_[c] = cell_start_[c + 1] - cell_start_[c];
   cell_cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (size_t i = 0; i < points.size(); ++i) {
     cell_points_[cell_cursor_[point_cell_[i]]++] = static_cast<int>(i);
@@ -86,6 +90,7 @@ void DynamicPointSearch::build_path(cv::Size image_size) {
 bool DynamicPointSearch::test(int index, const PointPredicate& is_dynamic) {
   result_.tested[index] = 1;
   ++result_.tested_count;
+  if (!point_cell_.empty()) --cell_untested_[point_cell_[index]];
   const bool dynamic = is_dynamic(index);
   if (dynamic) {
     result_.dynamic[index] = 1;
@@ -100,26 +105,53 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
   const float band = params_.band_width_px;
   for (int round = 0; round < params_.max_band_rounds; ++round) {
     ++result_.band_rounds;
+    // The hull of (previous hull vertices + new finds) is the hull of every find so far, so the
+    // community is reduced to its hull vertices each round: sorting stays cheap.
     convex_hull(community_, hull_scratch_, hull_);
+    community_.assign(hull_.begin(), hull_.end());
+    // Band membership: distance to the hull <= dZ. For a proper polygon the test is "every edge
+    // line is within dZ" (the outward offset with mitred corners, a slightly larger band near
+    // vertices): one dot product per edge with an early exit, instead of point-segment distances.
+    const bool polygon = hull_.size() >= 3;
+    edges_.clear();
+    if (polygon) {
+      for (size_t i = 0; i < hull_.size(); ++i) {
+        const Eigen::Vector2f d = hull_[(i + 1) % hull_.size()] - hull_[i];
+        const Eigen::Vector2f outward = Eigen::Vector2f(d.y(), -d.x()).normalized();
+        edges_.emplace_back(outward.x(), outward.y(), outward.dot(hull_[i]) + band);
+      }
+    }
+    const auto in_band = [&](const Eigen::Vector2f& p) {
+      if (!polygon) return distance_to_convex_hull(hull_, p) <= band;
+      for (const Eigen::Vector3f& e : edges_) {
+        if (e.x() * p.x() + e.y() * p.y() > e.z()) return false;
+      }
+      return true;
+    };
     Eigen::Vector2f lo = hull_[0], hi = hull_[0];
     for (const Eigen::Vector2f& v : hull_) {
       lo = lo.cwiseMin(v);
       hi = hi.cwiseMax(v);
     }
-    const int col0 = std::clamp(static_cast<int>((lo.x() - band) / cell_size_), 0, grid_cols_ - 1);
-    const int col1 = std::clamp(static_cast<int>((hi.x() + band) / cell_size_), 0, grid_cols_ - 1);
-    const int row0 = std::clamp(static_cast<int>((lo.y() - band) / cell_size_), 0, grid_rows_ - 1);
-    const int row1 = std::clamp(static_cast<int>((hi.y() + band) / cell_size_), 0, grid_rows_ - 1);
+    lo.array() -= band;
+    hi.array() += band;
+    const int col0 = std::clamp(static_cast<int>(lo.x() / cell_size_), 0, grid_cols_ - 1);
+    const int col1 = std::clamp(static_cast<int>(hi.x() / cell_size_), 0, grid_cols_ - 1);
+    const int row0 = std::clamp(static_cast<int>(lo.y() / cell_size_), 0, grid_rows_ - 1);
+    const int row1 = std::clamp(static_cast<int>(hi.y() / cell_size_), 0, grid_rows_ - 1);
     found_.clear();
     // The band is every untested point within dZ of the hull, interior included: points the hull
     // swallowed in one jump would otherwise never be tested.
     for (int row = row0; row <= row1; ++row) {
       for (int col = col0; col <= col1; ++col) {
         const int cell = row * grid_cols_ + col;
+        if (cell_untested_[cell] == 0) continue;
         for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
           const int index = cell_points_[k];
           if (result_.tested[index]) continue;
-          if (distance_to_convex_hull(hull_, points[index]) > band) continue;
+          const Eigen::Vector2f& p = points[index];
+          if (p.x() < lo.x() || p.y() < lo.y() || p.x() > hi.x() || p.y() > hi.y()) continue;
+          if (!in_band(p)) continue;
           if (test(index, is_dynamic)) found_.push_back(index);
         }
       }
@@ -139,6 +171,7 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   if (n == 0) return result_;
 
   if (params_.strategy == SearchStrategy::exhaustive) {
+    point_cell_.clear();  // no grid bookkeeping in the baseline
     for (size_t i = 0; i < n; ++i) test(static_cast<int>(i), is_dynamic);
     return result_;
   }
@@ -161,6 +194,7 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
     for (int r = std::max(0, row - 1); r <= std::min(grid_rows_ - 1, row + 1); ++r) {
       for (int c = std::max(0, col - 1); c <= std::min(grid_cols_ - 1, col + 1); ++c) {
         const int cell = r * grid_cols_ + c;
+        if (cell_untested_[cell] == 0) continue;
         for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
           const int index = cell_points_[k];
           if (result_.tested[index]) continue;

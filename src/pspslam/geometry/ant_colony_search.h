@@ -73,11 +73,13 @@ class DynamicPointSearch {
   std::vector<int> cell_points_;
   std::vector<int> point_cell_;
   std::vector<int> cell_cursor_;
+  std::vector<int> cell_untested_;
   cv::Size path_size_;
   std::vector<Eigen::Vector2f> path_nodes_;
   std::vector<Eigen::Vector2f> community_;
   std::vector<Eigen::Vector2f> hull_;
   std::vector<Eigen::Vector2f> hull_scratch_;
+  std::vector<Eigen::Vector3f> edges_;  // outward unit normal (x, y) and offset + dZ (z)
   std::vector<int> found_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/config/yaml_section.h"
@@ -10,9 +11,21 @@
 namespace pspslam {
 namespace {
 
-double milliseconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
+// Wall and thread-CPU clocks read together, so each stage part reports both.
+struct Stopwatch {
+  std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+  double cpu = thread_cpu_ms();
+
+  static double thread_cpu_ms() {
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
+  }
+  double wall_ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall).count();
+  }
+  double cpu_ms() const { return thread_cpu_ms() - cpu; }
+};
 
 }  // namespace
 
@@ -39,7 +52,7 @@ GeometryStage::GeometryStage(PinholeCamera camera, GeometryParams params)
       grower_(params.region) {}
 
 GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   if (input.depth.type() != CV_32FC1) throw Error("GeometryStage: depth must be CV_32FC1 metres");
   if (!input.keypoint_depths.empty() && input.keypoint_depths.size() != input.keypoints.size()) {
     throw Error("GeometryStage: " + std::to_string(input.keypoint_depths.size()) +
@@ -59,7 +72,8 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
              input.previous_dynamic_mask.size() == input.depth.size()) {
     result.warped_previous_mask = input.previous_dynamic_mask;  // no motion estimate: identity
   }
-  result.timing.homography_ms = milliseconds_since(start);
+  result.timing.homography_ms = start.wall_ms();
+  result.timing.homography_cpu_ms = start.cpu_ms();
 
   // Candidates with their depths.
   const size_t n = input.keypoints.size();
@@ -88,15 +102,16 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   }
 
   // III.C: reverse ant-colony search driving the multi-view test.
-  const auto search_start = std::chrono::steady_clock::now();
+  const Stopwatch search_start;
   test_.set_frame(input.T_world_camera, input.references);
   const SearchResult& search = search_.run(
       points_, input.depth.size(),
       [this](int index) { return test_.is_dynamic(candidates_[index]); }, priority_);
-  result.timing.search_ms = milliseconds_since(search_start);
+  result.timing.search_ms = search_start.wall_ms();
+  result.timing.search_cpu_ms = search_start.cpu_ms();
 
   // Region growing from the dynamic points; verified-static points may act as barriers.
-  const auto region_start = std::chrono::steady_clock::now();
+  const Stopwatch region_start;
   seeds_.clear();
   seed_depths_.clear();
   static_points_.clear();
@@ -109,7 +124,8 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
     }
   }
   grower_.grow(input.depth, seeds_, seed_depths_, static_points_, result.dynamic_mask);
-  result.timing.region_ms = milliseconds_since(region_start);
+  result.timing.region_ms = region_start.wall_ms();
+  result.timing.region_cpu_ms = region_start.cpu_ms();
 
   result.keypoint_tested = search.tested;
   result.keypoint_tested_dynamic = search.dynamic;
@@ -123,7 +139,8 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
     result.keypoint_dynamic[i] = search.dynamic[i] || in_mask;
     result.dynamic_count += result.keypoint_dynamic[i];
   }
-  result.timing.total_ms = milliseconds_since(start);
+  result.timing.total_ms = start.wall_ms();
+  result.timing.total_cpu_ms = start.cpu_ms();
   return result;
 }
 

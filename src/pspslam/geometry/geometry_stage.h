@@ -46,11 +46,17 @@ struct GeometryFrameInput {
   cv::Mat previous_dynamic_mask;  // optional CV_8UC1 (non-zero = dynamic) of the previous frame
 };
 
+// Wall-clock and thread-CPU milliseconds of each part. CPU time is what the stage itself costs;
+// on a loaded machine wall time also counts waiting for a core.
 struct GeometryTiming {
   double homography_ms = 0.0;
   double search_ms = 0.0;  // ant-colony (or exhaustive) search including the multi-view tests
   double region_ms = 0.0;
   double total_ms = 0.0;
+  double homography_cpu_ms = 0.0;
+  double search_cpu_ms = 0.0;
+  double region_cpu_ms = 0.0;
+  double total_cpu_ms = 0.0;
 };
 
 struct GeometryFrameResult {

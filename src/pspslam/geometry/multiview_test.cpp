@@ -86,8 +86,12 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
     const double projected_depth = p_ref.z();
     if (projected_depth < params_.min_depth_m || projected_depth > params_.max_depth_m) continue;
     const Eigen::Vector2d pixel = camera_.project(p_ref);
-    const int u = static_cast<int>(std::lround(pixel.x()));
-    const int v = static_cast<int>(std::lround(pixel.y()));
+    if (!(pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < ref.depth.cols &&
+          pixel.y() < ref.depth.rows))
+      continue;
+    // Non-negative here, so truncation after +0.5 rounds (std::lround is a libm call).
+    const int u = static_cast<int>(pixel.x() + 0.5);
+    const int v = static_cast<int>(pixel.y() + 0.5);
     if (u < r || v < r || u >= ref.depth.cols - r || v >= ref.depth.rows - r) continue;
     // Parallax: angle at the point between the rays to the two camera centres.
     const Eigen::Vector3d ray_ref = p_current - ref.center_in_current;
@@ -95,23 +99,24 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
     if (cos_parallax < cos_max_parallax_) continue;
     const double threshold =
         params_.depth_threshold_abs_m + params_.depth_threshold_relative * projected_depth;
-    // The reference agrees when any valid pixel of the patch is consistent with the point.
+    // The reference agrees when any valid pixel of the patch is consistent with the point. The
+    // centre is checked first: for the many static points it settles the question at once.
     int valid_pixels = 0;
     bool consistent = false;
+    const auto check = [&](float measured) {
+      if (!(measured > 0.0f)) return;
+      ++valid_pixels;
+      const double difference = measured - projected_depth;
+      const bool disagrees = params_.disagreement == DepthDisagreement::farther_only
+                                 ? difference > threshold
+                                 : std::abs(difference) > threshold;
+      if (!disagrees) consistent = true;
+    };
+    check(ref.depth.ptr<float>(v)[u]);
     for (int dv = -r; dv <= r && !consistent; ++dv) {
       const float* row = ref.depth.ptr<float>(v + dv);
-      for (int du = -r; du <= r; ++du) {
-        const double measured = row[u + du];
-        if (!(measured > 0.0)) continue;
-        ++valid_pixels;
-        const double difference = measured - projected_depth;
-        const bool disagrees = params_.disagreement == DepthDisagreement::farther_only
-                                   ? difference > threshold
-                                   : std::abs(difference) > threshold;
-        if (!disagrees) {
-          consistent = true;
-          break;
-        }
+      for (int du = -r; du <= r && !consistent; ++du) {
+        if (du != 0 || dv != 0) check(row[u + du]);
       }
     }
     if (valid_pixels == 0) continue;
@@ -120,7 +125,6 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
     // With "any" (fraction reached by one vote) the first dynamic vote decides: no need to
     // look at the remaining references.
     if (verdict.dynamic_votes >= 1 &&
-        params_.min_dynamic_vote_fraction * (verdict.valid_references) <= 1.0 &&
         params_.min_dynamic_vote_fraction * static_cast<double>(references_.size()) <= 1.0)
       break;
   }

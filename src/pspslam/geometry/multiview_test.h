@@ -34,9 +34,10 @@ struct MultiViewParams {
   double max_parallax_deg = 30.0;
   // Half-size of the reference depth patch: the reference votes dynamic only if *every* valid
   // pixel of the (2r+1)^2 patch disagrees, which absorbs depth edges and small pose errors.
-  int reference_patch_radius = 1;
-  // Fraction of the valid references that must vote dynamic (a tiny value means "any").
-  double min_dynamic_vote_fraction = 0.5;
+  int reference_patch_radius = 4;
+  // Fraction of the valid references that must vote dynamic; 0.2 = "any one" for up to 5
+  // references (a person that stood still in some references is still caught).
+  double min_dynamic_vote_fraction = 0.2;
   int max_reference_views = 5;
   double min_depth_m = 0.1;
   double max_depth_m = 8.0;

@@ -83,6 +83,8 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
   const float radius_cells = params_.max_grow_radius_px / static_cast<float>(s);
   const float radius2 = radius_cells * radius_cells;
   region_seeds_.clear();
+  // Bounding box of all grown cells: the full-resolution fill only visits it.
+  int min_x = cols, max_x = -1, min_y = rows, max_y = -1;
   for (size_t seed_index = 0; seed_index < seeds.size(); ++seed_index) {
     const Eigen::Vector2f& seed = seeds[seed_index];
     const float wanted = seed_depths[seed_index];
@@ -114,6 +116,10 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     region_seeds_.push_back(1);
     region_of_[start] = region_id;
     queue_.assign(1, static_cast<int>(start));
+    min_x = std::min(min_x, sx);
+    max_x = std::max(max_x, sx);
+    min_y = std::min(min_y, sy);
+    max_y = std::max(max_y, sy);
     size_t head = 0;
     while (head < queue_.size() && static_cast<int>(queue_.size()) < params_.max_region_samples) {
       const int cell = queue_[head++];
@@ -133,27 +139,35 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
           continue;
         region_of_[next] = region_id;
         queue_.push_back(static_cast<int>(next));
+        min_x = std::min(min_x, nx);
+        max_x = std::max(max_x, nx);
+        min_y = std::min(min_y, ny);
+        max_y = std::max(max_y, ny);
       }
     }
   }
+  if (max_x < 0) return;
   // Regions that too few seeds support are dropped before painting.
-  for (int& region : region_of_) {
-    if (region >= 0 && region_seeds_[region] < params_.min_seeds_per_region) region = -1;
+  for (int gy = min_y; gy <= max_y; ++gy) {
+    int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
+    for (int gx = min_x; gx <= max_x; ++gx) {
+      if (regions[gx] >= 0 && region_seeds_[regions[gx]] < params_.min_seeds_per_region)
+        regions[gx] = -1;
+    }
   }
   // Full-resolution fill: a pixel of a grown block joins only if its own depth is continuous with
   // the block's sample, so silhouettes stay pixel-sharp although growth ran on the coarse grid.
-  for (int y = 0; y < depth.rows; ++y) {
+  const int x_end = std::min(depth.cols, (max_x + 1) * s);
+  const int y_end = std::min(depth.rows, (max_y + 1) * s);
+  for (int y = min_y * s; y < y_end; ++y) {
     const int gy = y / s;
     const int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
     const float* samples = grid_depth_.ptr<float>(gy);
     const float* row = depth.ptr<float>(y);
     std::uint8_t* out = mask.ptr<std::uint8_t>(y);
-    for (int x = 0; x < depth.cols; ++x) {
+    for (int x = min_x * s; x < x_end; ++x) {
       const int gx = x / s;
-      if (regions[gx] < 0) {
-        out[x] = 0;
-        continue;
-      }
+      if (regions[gx] < 0) continue;  // mask was cleared above
       const float sample = samples[gx];
       const double step = params_.max_step_abs_m + params_.max_step_relative * sample;
       out[x] = row[x] > 0.0f && std::abs(row[x] - sample) <= step ? 255 : 0;

@@ -25,7 +25,7 @@ struct RegionGrowParams {
   double max_depth_from_seed_m = 0.6;
   // Bounded growth: a seed only claims samples within this image distance of itself. A wrong
   // seed on a wall then marks a small disc, not the wall; a person is covered by many seeds.
-  float max_grow_radius_px = 40.0f;
+  float max_grow_radius_px = 60.0f;
   // A grown region is kept only when at least this many dynamic seeds fall inside it, so one
   // isolated false detection does not mask anything beyond its own keypoint.
   int min_seeds_per_region = 2;
@@ -33,8 +33,10 @@ struct RegionGrowParams {
   int max_region_samples = 40000;
   // Grid samples within this radius (pixels) of a point verified static are barriers.
   float static_barrier_radius_px = 0.0f;
-  // Final dilation of the mask (pixels) to cover the depth edge around objects.
-  int dilation_px = 2;
+  // Dilation of the mask (pixels). 0 by default: the fill is already pixel-exact and a margin
+  // turns background keypoints along every silhouette into false positives (docs/geometry.md);
+  // margins for map exclusion belong in fuse_dynamic_masks().
+  int dilation_px = 0;
 
   static RegionGrowParams from_yaml(YamlSection& section);
 };

@@ -58,12 +58,24 @@ std::vector<FrameFiles> read_associations(const std::filesystem::path& file) {
 std::string describe_type(const cv::Mat& image) {
   std::string depth;
   switch (image.depth()) {
-    case CV_8U: depth = "8-bit"; break;
-    case CV_8S: depth = "8-bit signed"; break;
-    case CV_16U: depth = "16-bit"; break;
-    case CV_16S: depth = "16-bit signed"; break;
-    case CV_32F: depth = "32-bit float"; break;
-    default: depth = "type " + std::to_string(image.depth()); break;
+    case CV_8U:
+      depth = "8-bit";
+      break;
+    case CV_8S:
+      depth = "8-bit signed";
+      break;
+    case CV_16U:
+      depth = "16-bit";
+      break;
+    case CV_16S:
+      depth = "16-bit signed";
+      break;
+    case CV_32F:
+      depth = "32-bit float";
+      break;
+    default:
+      depth = "type " + std::to_string(image.depth());
+      break;
   }
   const int channels = image.channels();
   return depth + ", " + std::to_string(channels) + (channels == 1 ? " channel" : " channels");
@@ -162,8 +174,8 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
   if (sequence.missing_files_ > 0) {
     sequence.warning_ = dir.string() + ": " + std::to_string(sequence.missing_files_) +
                         " listed files are missing; skipped " +
-                        std::to_string(sequence.skipped_frames_) + " frames (first: " +
-                        first_missing + ")";
+                        std::to_string(sequence.skipped_frames_) +
+                        " frames (first: " + first_missing + ")";
     if (options.warnings != nullptr) *options.warnings << "warning: " << sequence.warning_ << "\n";
   }
   if (sequence.frames_.empty()) {

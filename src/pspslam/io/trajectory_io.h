@@ -43,7 +43,9 @@ class TrajectoryWriter {
   explicit TrajectoryWriter(const std::filesystem::path& file);
 
   void write(const StampedPose& pose);
-  void write(Timestamp timestamp, const Pose& T_world_camera) { write({timestamp, T_world_camera}); }
+  void write(Timestamp timestamp, const Pose& T_world_camera) {
+    write({timestamp, T_world_camera});
+  }
 
   size_t count() const { return count_; }
   const std::filesystem::path& path() const { return path_; }

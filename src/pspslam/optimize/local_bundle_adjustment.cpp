@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -145,6 +147,7 @@ class BaStage {
 
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &ceres_problem, &summary);
+    if (std::getenv("PSPSLAM_DIAG")) fprintf(stderr, "%s\n", summary.FullReport().c_str());
     return summary.num_successful_steps + summary.num_unsuccessful_steps;
   }
 

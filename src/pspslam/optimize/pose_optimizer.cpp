@@ -4,9 +4,9 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <array>
 #include <memory>
 
-#include "pspslam/optimize/pose_manifold.h"
 #include "pspslam/optimize/reprojection_error.h"
 
 namespace pspslam {
@@ -27,62 +27,98 @@ double observation_chi_squared(const StereoProjection& model, const PoseObservat
   return chi_squared<2>(model, observation.pixel, sqrt_information, point_camera);
 }
 
-// All selected observations of the frame as a single residual block over the pose. One block per
-// observation made Ceres' per-block bookkeeping (evaluation preparation, validity checks, building
-// the problem each round) dominate the run time; here the inner loop is ours and allocation-free.
+// The pose update of one round: δ = [ω; v] applied on the left of the round's base pose,
+// T(δ) = (Exp(ω), v) · T_base, i.e. p_c = Exp(ω) q + v with q = T_base p_w.
+Pose apply_update(const std::array<double, 6>& delta, const Pose& base) {
+  const Eigen::Vector3d omega(delta[0], delta[1], delta[2]);
+  Pose update = Pose::Identity();
+  const double angle = omega.norm();
+  if (angle > 0.0) update.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  update.translation() = Eigen::Vector3d(delta[3], delta[4], delta[5]);
+  return update * base;
+}
+
+// Left Jacobian of SO(3): Exp(ω + dω) ≈ Exp(J_l(ω) dω) Exp(ω).
+Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& omega) {
+  const double angle = omega.norm();
+  Eigen::Matrix3d skew;
+  skew << 0.0, -omega.z(), omega.y(), omega.z(), 0.0, -omega.x(), -omega.y(), omega.x(), 0.0;
+  if (angle < 1e-8) return Eigen::Matrix3d::Identity() + 0.5 * skew;
+  const double angle2 = angle * angle;
+  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(angle)) / angle2 * skew +
+         (angle - std::sin(angle)) / (angle2 * angle) * skew * skew;
+}
+
+// One selected observation, prepared for the inner loop: the point already in the base camera
+// frame, the measurement and its weight.
+struct PreparedObservation {
+  Eigen::Vector3d point_base;
+  Eigen::Vector3d measured;  // u, v, u_r (u_r unused without depth)
+  double sqrt_information;
+  bool has_depth;
+};
+
+// All selected observations of the frame as a single residual block over the 6-vector δ.
+// Why one block and no Manifold: with one block per observation, Ceres' per-block bookkeeping
+// (evaluation preparation, validity checks, the ambient-to-tangent Jacobian product of a
+// manifold, building the problem each round) cost more than the residuals themselves. Here the
+// parameter block is Euclidean (δ, re-based every round) and the inner loop is ours.
 // Because Ceres applies a loss function to a whole block, the Huber kernel is applied inside, per
 // observation, the way g2o does it: the residual is scaled to carry ρ(s) (so the cost is the
 // robust cost) and the Jacobian is weighted by √ρ'(s) (iteratively reweighted least squares).
 class FrameReprojectionCost final : public ceres::CostFunction {
  public:
-  FrameReprojectionCost(const StereoProjection& model,
-                        const std::vector<PoseObservation>& observations,
-                        const std::vector<uint8_t>& selected, bool robust,
-                        const PoseOptimizerOptions& options)
+  FrameReprojectionCost(const StereoProjection& model, std::vector<PreparedObservation> prepared,
+                        bool robust, const PoseOptimizerOptions& options)
       : model_(model),
-        observations_(observations),
+        prepared_(std::move(prepared)),
         robust_(robust),
         huber_delta_mono_(options.huber_delta_mono),
         huber_delta_stereo_(options.huber_delta_stereo) {
     int num_residuals = 0;
-    for (size_t i = 0; i < observations.size(); ++i) {
-      if (!selected[i]) continue;
-      selected_.push_back(i);
-      num_residuals += has_depth(observations[i]) ? 3 : 2;
+    for (const PreparedObservation& observation : prepared_) {
+      num_residuals += observation.has_depth ? 3 : 2;
     }
     set_num_residuals(num_residuals);
-    mutable_parameter_block_sizes()->push_back(PoseParameters::kAmbientSize);
+    mutable_parameter_block_sizes()->push_back(6);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    const Eigen::Map<const Eigen::Vector3d> omega(parameters[0]);
+    const Eigen::Map<const Eigen::Vector3d> translation(parameters[0] + 3);
+    const double angle = omega.norm();
+    const Eigen::Matrix3d rotation =
+        angle > 0.0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
+                    : Eigen::Matrix3d::Identity();
     double* jacobian = jacobians != nullptr ? jacobians[0] : nullptr;
+    const Eigen::Matrix3d left_jacobian =
+        jacobian != nullptr ? so3_left_jacobian(omega) : Eigen::Matrix3d::Identity();
     int row = 0;
-    for (const size_t index : selected_) {
-      const PoseObservation& observation = observations_[index];
-      const bool ok = has_depth(observation)
-                          ? evaluate_one<3>(observation, parameters[0], residuals + row,
-                                            jacobian ? jacobian + row * 7 : nullptr)
-                          : evaluate_one<2>(observation, parameters[0], residuals + row,
-                                            jacobian ? jacobian + row * 7 : nullptr);
+    for (const PreparedObservation& observation : prepared_) {
+      const Eigen::Vector3d point_camera = rotation * observation.point_base + translation;
+      double* jacobian_rows = jacobian != nullptr ? jacobian + row * 6 : nullptr;
+      const bool ok =
+          observation.has_depth
+              ? evaluate_one<3>(observation, point_camera, left_jacobian, residuals + row,
+                                jacobian_rows)
+              : evaluate_one<2>(observation, point_camera, left_jacobian, residuals + row,
+                                jacobian_rows);
       if (!ok) return false;  // a point went behind the camera: Ceres rejects the step
-      row += has_depth(observation) ? 3 : 2;
+      row += observation.has_depth ? 3 : 2;
     }
     return true;
   }
 
  private:
   template <int kResiduals>
-  bool evaluate_one(const PoseObservation& observation, const double* pose, double* residual_out,
+  bool evaluate_one(const PreparedObservation& observation, const Eigen::Vector3d& point_camera,
+                    const Eigen::Matrix3d& left_jacobian, double* residual_out,
                     double* jacobian_out) const {
-    Measurement<kResiduals> measured;
-    measured.template head<2>() = observation.pixel;
-    if constexpr (kResiduals == 3) measured(2) = observation.right_u;
-    const Eigen::Vector3d point_camera = transform_point(pose, observation.point_world);
     Eigen::Matrix<double, kResiduals, 1> residual;
     Eigen::Matrix<double, kResiduals, 3> d_residual_d_point;
-    if (!whitened_residual<kResiduals>(model_, measured, std::sqrt(observation.information),
-                                       point_camera, residual,
+    if (!whitened_residual<kResiduals>(model_, observation.measured.head<kResiduals>(),
+                                       observation.sqrt_information, point_camera, residual,
                                        jacobian_out ? &d_residual_d_point : nullptr)) {
       return false;
     }
@@ -97,18 +133,40 @@ class FrameReprojectionCost final : public ceres::CostFunction {
     Eigen::Map<Eigen::Matrix<double, kResiduals, 1>> output(residual_out);
     output = residual;
     if (jacobian_out != nullptr) {
-      write_pose_jacobian<kResiduals>(d_residual_d_point, point_camera, jacobian_out);
+      // ∂p_c/∂ω = −[p_c]× J_l(ω), ∂p_c/∂v = I.
+      Eigen::Matrix3d minus_skew;
+      minus_skew << 0.0, point_camera.z(), -point_camera.y(),  //
+          -point_camera.z(), 0.0, point_camera.x(),            //
+          point_camera.y(), -point_camera.x(), 0.0;
+      Eigen::Map<Eigen::Matrix<double, kResiduals, 6, Eigen::RowMajor>> jacobian(jacobian_out);
+      jacobian.template leftCols<3>() = d_residual_d_point * (minus_skew * left_jacobian);
+      jacobian.template rightCols<3>() = d_residual_d_point;
     }
     return true;
   }
 
   StereoProjection model_;
-  const std::vector<PoseObservation>& observations_;
-  std::vector<size_t> selected_;
+  std::vector<PreparedObservation> prepared_;
   bool robust_;
   double huber_delta_mono_;
   double huber_delta_stereo_;
 };
+
+std::vector<PreparedObservation> prepare(const std::vector<PoseObservation>& observations,
+                                         const std::vector<uint8_t>& selected,
+                                         const Pose& base) {
+  std::vector<PreparedObservation> prepared;
+  prepared.reserve(observations.size());
+  for (size_t i = 0; i < observations.size(); ++i) {
+    if (!selected[i]) continue;
+    const PoseObservation& observation = observations[i];
+    prepared.push_back({base * observation.point_world,
+                        {observation.pixel.x(), observation.pixel.y(), observation.right_u},
+                        std::sqrt(observation.information),
+                        has_depth(observation)});
+  }
+  return prepared;
+}
 
 ceres::Solver::Options round_solver_options(const PoseOptimizerOptions& options) {
   ceres::Solver::Options solver_options;
@@ -136,43 +194,38 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
   if (observations.empty()) return result;
 
   const StereoProjection model = StereoProjection::from(camera, bf);
-  PoseParameters pose = PoseParameters::from_pose(initial_T_camera_world);
-  PoseManifold manifold;
   const ceres::Solver::Options solver_options = round_solver_options(options);
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // lives on this frame
+  Pose pose = initial_T_camera_world;
 
   // Every observation starts as an inlier unless it already lies behind the camera.
   std::vector<uint8_t>& inlier = result.inlier;
   for (size_t i = 0; i < observations.size(); ++i) {
-    inlier[i] =
-        std::isfinite(observation_chi_squared(model, observations[i], initial_T_camera_world));
+    inlier[i] = std::isfinite(observation_chi_squared(model, observations[i], pose));
   }
 
   for (int round = 0; round < options.rounds; ++round) {
     if (std::find(inlier.begin(), inlier.end(), uint8_t{1}) == inlier.end()) break;
     const bool robust = round < options.robust_rounds;
-    ceres::Problem problem(problem_options);
-    problem.AddParameterBlock(pose.data(), PoseParameters::kAmbientSize, &manifold);
-    auto cost = std::make_unique<FrameReprojectionCost>(model, observations, inlier, robust,
-                                                        options);
-    problem.AddResidualBlock(cost.release(), nullptr, pose.data());
-
+    std::array<double, 6> delta{};  // starts at the current pose, which is the round's base
+    ceres::Problem problem;
+    auto cost = std::make_unique<FrameReprojectionCost>(model, prepare(observations, inlier, pose),
+                                                        robust, options);
+    problem.AddResidualBlock(cost.release(), nullptr, delta.data());
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+    pose = apply_update(delta, pose);
 
     // Re-classify all observations, including earlier outliers: a better pose can redeem them.
-    const Pose current = pose.to_pose();
     int num_inliers = 0;
     for (size_t i = 0; i < observations.size(); ++i) {
       const double threshold = has_depth(observations[i]) ? options.chi2_stereo : options.chi2_mono;
-      inlier[i] = observation_chi_squared(model, observations[i], current) <= threshold;
+      inlier[i] = observation_chi_squared(model, observations[i], pose) <= threshold;
       num_inliers += inlier[i];
     }
     if (num_inliers < options.min_inliers_to_continue) break;
   }
 
-  result.T_camera_world = pose.to_pose();
+  result.T_camera_world = pose;
   result.num_inliers = static_cast<int>(std::count(inlier.begin(), inlier.end(), uint8_t{1}));
   return result;
 }

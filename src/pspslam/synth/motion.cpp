@@ -26,7 +26,9 @@ Eigen::Matrix3d look_rotation(double yaw, double pitch) {
   return R;
 }
 
-Eigen::Matrix3d rot_y(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+Eigen::Matrix3d rot_y(double angle) {
+  return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
 
 }  // namespace
 
@@ -71,8 +73,9 @@ Pose CameraPath::T_world_camera(double t) const {
   Pose pose = Pose::Identity();
   const double shake_angle = shake_rotation.norm();
   const Eigen::Matrix3d shake =
-      shake_angle > 0 ? Eigen::AngleAxisd(shake_angle, shake_rotation / shake_angle).toRotationMatrix()
-                      : Eigen::Matrix3d::Identity();
+      shake_angle > 0
+          ? Eigen::AngleAxisd(shake_angle, shake_rotation / shake_angle).toRotationMatrix()
+          : Eigen::Matrix3d::Identity();
   pose.linear() = look_rotation(yaw, pitch) *
                   Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() * shake;
   pose.translation() = position + shake_translation;
@@ -98,7 +101,7 @@ WalkingBody::WalkingBody(int index, uint64_t seed, bool carries_box, const RoomL
   direction_ = (index % 2 == 0) ? 1.0 : -1.0;
   speed_ = 0.6 + 0.7 * unit(body_seed, 3);
   scale_ = 0.95 + 0.1 * unit(body_seed, 4);
-  parts_ = {BodyPart::kTorso,   BodyPart::kHead,    BodyPart::kLeftArm,
+  parts_ = {BodyPart::kTorso,    BodyPart::kHead,    BodyPart::kLeftArm,
             BodyPart::kRightArm, BodyPart::kLeftLeg, BodyPart::kRightLeg};
   if (carries_box_) parts_.push_back(BodyPart::kCarriedBox);
 
@@ -182,16 +185,19 @@ void WalkingBody::pose_parts(double t, std::vector<BodyPartPose>& out) const {
   for (const BodyPart part : parts_) {
     switch (part) {
       case BodyPart::kTorso:
-        out.push_back(rigid(Eigen::Vector3d(0, 0, 1.16 * s), Eigen::Vector3d(0.11, 0.19, 0.30) * s));
+        out.push_back(
+            rigid(Eigen::Vector3d(0, 0, 1.16 * s), Eigen::Vector3d(0.11, 0.19, 0.30) * s));
         break;
       case BodyPart::kHead:
-        out.push_back(rigid(Eigen::Vector3d(0, 0, 1.60 * s), Eigen::Vector3d(0.10, 0.085, 0.12) * s));
+        out.push_back(
+            rigid(Eigen::Vector3d(0, 0, 1.60 * s), Eigen::Vector3d(0.10, 0.085, 0.12) * s));
         break;
       case BodyPart::kLeftArm:
         out.push_back(limb(Eigen::Vector3d(0, 0.25, 1.42) * s, 0.33 * s, 0.05 * s, left_arm_swing));
         break;
       case BodyPart::kRightArm:
-        out.push_back(limb(Eigen::Vector3d(0, -0.25, 1.42) * s, 0.33 * s, 0.05 * s, right_arm_swing));
+        out.push_back(
+            limb(Eigen::Vector3d(0, -0.25, 1.42) * s, 0.33 * s, 0.05 * s, right_arm_swing));
         break;
       case BodyPart::kLeftLeg:
         out.push_back(limb(Eigen::Vector3d(0, 0.1, 0.86) * s, 0.43 * s, 0.07 * s, leg_swing));

@@ -71,7 +71,7 @@ class WalkingBody {
   double direction_;  // +1 or -1: which way round the lap
   double start_m_;    // where on the lap the person is at t = 0
   double speed_;
-  double scale_;      // body height / 1.72 m
+  double scale_;                      // body height / 1.72 m
   std::vector<double> lap_distance_;  // arc length at tau = 2 pi k / (n - 1), for constant speed
 };
 

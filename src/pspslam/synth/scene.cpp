@@ -40,7 +40,7 @@ struct FrameBox {
   Eigen::Matrix3f R_box_camera;
   Eigen::Vector3f camera_in_box;
   Eigen::Vector3f half;
-  std::array<float, 6> face_light{};  // view-independent diffuse term of each face
+  std::array<float, 6> face_light{};   // lighting of each face (1 when baked into the texture)
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // screen rectangle that can contain the box (end exclusive)
   uint16_t first_surface_id = 0;
 };
@@ -54,20 +54,20 @@ struct Furniture {
 // Furniture along the walls, leaving the middle free for the camera and the walking people.
 const std::vector<Furniture>& furniture_layout() {
   static const std::vector<Furniture> layout = {
-      {{1.5, 0.25, 0.45}, {0.6, 0.25, 0.45}},            // cabinet
-      {{6.78, 2.0, 0.95}, {0.22, 0.5, 0.95}},            // tall shelf
-      {{4.5, 5.6, 0.38}, {0.7, 0.4, 0.38}},              // desk
-      {{4.2, 5.65, 0.86}, {0.15, 0.15, 0.1}, 0.3},       // box on the desk
-      {{0.4, 3.2, 0.22}, {0.4, 0.9, 0.22}},              // sofa seat
-      {{0.1, 3.2, 0.5}, {0.1, 0.9, 0.5}},                // sofa back
-      {{6.55, 0.45, 0.3}, {0.3, 0.3, 0.3}, 0.2},         // crate
-      {{6.55, 0.45, 0.72}, {0.18, 0.18, 0.12}, -0.3},    // small crate on it
-      {{0.3, 0.3, 1.4}, {0.2, 0.2, 1.4}},                // corner column
-      {{3.0, 5.985, 1.6}, {0.6, 0.015, 0.4}},            // picture
-      {{3.4, 0.015, 1.0}, {0.45, 0.015, 1.0}},           // door
-      {{6.985, 4.3, 1.5}, {0.015, 0.7, 0.5}},            // whiteboard
-      {{1.6, 5.75, 0.35}, {0.5, 0.25, 0.35}},            // low cabinet
-      {{6.6, 5.6, 0.4}, {0.2, 0.2, 0.4}},                // planter
+      {{1.5, 0.25, 0.45}, {0.6, 0.25, 0.45}},          // cabinet
+      {{6.78, 2.0, 0.95}, {0.22, 0.5, 0.95}},          // tall shelf
+      {{4.5, 5.6, 0.38}, {0.7, 0.4, 0.38}},            // desk
+      {{4.2, 5.65, 0.86}, {0.15, 0.15, 0.1}, 0.3},     // box on the desk
+      {{0.4, 3.2, 0.22}, {0.4, 0.9, 0.22}},            // sofa seat
+      {{0.1, 3.2, 0.5}, {0.1, 0.9, 0.5}},              // sofa back
+      {{6.55, 0.45, 0.3}, {0.3, 0.3, 0.3}, 0.2},       // crate
+      {{6.55, 0.45, 0.72}, {0.18, 0.18, 0.12}, -0.3},  // small crate on it
+      {{0.3, 0.3, 1.4}, {0.2, 0.2, 1.4}},              // corner column
+      {{3.0, 5.985, 1.6}, {0.6, 0.015, 0.4}},          // picture
+      {{3.4, 0.015, 1.0}, {0.45, 0.015, 1.0}},         // door
+      {{6.985, 4.3, 1.5}, {0.015, 0.7, 0.5}},          // whiteboard
+      {{1.6, 5.75, 0.35}, {0.5, 0.25, 0.35}},          // low cabinet
+      {{6.6, 5.6, 0.4}, {0.2, 0.2, 0.4}},              // planter
   };
   return layout;
 }
@@ -89,14 +89,46 @@ BodyLook body_look(uint64_t body_seed) {
                         static_cast<uchar>(rng.uniform(30, 220)));
   look.shirt = {shirt, shirt * 0.55, 0.5, 8.0, 20.0, 2.0, 1.0, 0.7};
   const int trousers = rng.uniform(25, 90);
-  look.trousers = {bgr(trousers + 25, trousers, trousers - 10), bgr(trousers / 2 + 10, trousers / 2, trousers / 3),
-                   0.4, 4.0, 6.0, 0.0, 0.0, 0.2};
+  look.trousers = {bgr(trousers + 25, trousers, trousers - 10),
+                   bgr(trousers / 2 + 10, trousers / 2, trousers / 3),
+                   0.4,
+                   4.0,
+                   6.0,
+                   0.0,
+                   0.0,
+                   0.2};
   const int tone = rng.uniform(0, 3);
   const cv::Vec3b skins[] = {bgr(150, 180, 225), bgr(95, 135, 185), bgr(50, 80, 120)};
   look.skin = {skins[tone], skins[tone] * 0.7, 0.3, 10.0, 0.0, 0.0, 0.0, 0.1};
   // Cardboard with tape and printing: well textured, so trackers do see features on it.
   look.carried_box = {bgr(45, 95, 140), bgr(110, 170, 215), 0.6, 10.0, 25.0, 10.0, 40.0, 0.3};
   return look;
+}
+
+// View-independent lighting: a diffuse term from the face's world normal plus two ceiling
+// lamps that fall off with distance. Static surfaces have it baked into their textures;
+// moving boxes get it per face and frame (evaluated at the face centre).
+constexpr float kLampA[3] = {2.3f, 3.0f, 2.6f};
+constexpr float kLampB[3] = {4.9f, 3.0f, 2.6f};
+
+float light_at(const Eigen::Vector3d& world_point, const Eigen::Vector3d& world_normal) {
+  static constexpr double kSun[3] = {0.25197631533948484, 0.41996052556580804,
+                                     0.83992105113161610};  // (0.3, 0.5, 1) normalised
+  const double sun =
+      world_normal.x() * kSun[0] + world_normal.y() * kSun[1] + world_normal.z() * kSun[2];
+  const auto lamp = [&](const float* at) {
+    const double dx = world_point.x() - at[0], dy = world_point.y() - at[1],
+                 dz = world_point.z() - at[2];
+    return 0.35 / (1.0 + (dx * dx + dy * dy + dz * dz) / 3.0);
+  };
+  return static_cast<float>(0.6 + 0.3 * std::max(0.0, sun) + lamp(kLampA) + lamp(kLampB));
+}
+
+// Outward normal of a face in box coordinates (inward for the room, seen from inside).
+Eigen::Vector3d face_normal(int face, bool seen_from_inside) {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  normal[face / 2] = (face % 2 ? 1.0 : -1.0) * (seen_from_inside ? -1.0 : 1.0);
+  return normal;
 }
 
 // Runs fn(row_begin, row_end) over chunks of rows on `threads` threads. Every pixel's result
@@ -143,7 +175,8 @@ void SynthOptions::validate() const {
     throw Error("synth: flag --carried-objects must be >= 0, got " +
                 std::to_string(carried_objects));
   }
-  if (threads < 0) throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
+  if (threads < 0)
+    throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
 }
 
 CameraConfig synthetic_camera_config() {
@@ -185,10 +218,14 @@ struct SyntheticScene::Impl {
   std::vector<synth::WalkingBody> bodies;
   std::vector<std::vector<BoxSurface>> body_boxes;  // per body, in WalkingBody::parts() order
   std::vector<float> column_xn, row_yn;             // normalised ray coordinates of pixel centres
+  std::vector<float> ray_length;                    // |(x_n, y_n, 1)| per pixel, row-major
 
  private:
+  // `static_pose`: the pose of a box that never moves, whose lighting is baked into its
+  // textures; nullptr for moving boxes (lit per frame).
   BoxSurface make_box(const Eigen::Vector3d& half, bool inside, uint8_t label,
-                      const synth::TextureRecipe* recipe, float texels_per_metre, uint64_t seed);
+                      const synth::TextureRecipe* recipe, float texels_per_metre, uint64_t seed,
+                      const Pose* static_pose);
 };
 
 SyntheticScene::Impl::Impl(const SynthOptions& opts)
@@ -202,26 +239,27 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
 
   // Static scene: every face gets its own recipe and texture.
   const uint64_t static_seed = synth::mix_hash(opts.seed, 0x57A71Cu);
-  static_boxes.push_back(make_box(room.size / 2.0, true, kSynthLabelStatic, nullptr,
-                                  kStaticTexelsPerMetre, synth::mix_hash(static_seed, 0)));
   static_poses.push_back(Pose(Eigen::Translation3d(room.size / 2.0)));
+  static_boxes.push_back(make_box(room.size / 2.0, true, kSynthLabelStatic, nullptr,
+                                  kStaticTexelsPerMetre, synth::mix_hash(static_seed, 0),
+                                  &static_poses.back()));
   for (size_t i = 0; i < furniture_layout().size(); ++i) {
     const Furniture& item = furniture_layout()[i];
-    static_boxes.push_back(make_box(item.half, false, kSynthLabelStatic, nullptr,
-                                    kStaticTexelsPerMetre, synth::mix_hash(static_seed, i + 1)));
     Pose pose = Pose::Identity();
     pose.linear() = Eigen::AngleAxisd(item.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     pose.translation() = item.centre;
     static_poses.push_back(pose);
+    static_boxes.push_back(make_box(item.half, false, kSynthLabelStatic, nullptr,
+                                    kStaticTexelsPerMetre, synth::mix_hash(static_seed, i + 1),
+                                    &static_poses.back()));
   }
 
   for (int b = 0; b < options.bodies; ++b) {
     // Hand-held: people walk laps in front of where the camera mostly looks; loop: round the
     // whole room, since the loop camera looks in every direction.
-    const std::optional<double> sector =
-        opts.trajectory == SynthTrajectory::kHandheld
-            ? std::optional<double>(camera_path.mean_heading())
-            : std::nullopt;
+    const std::optional<double> sector = opts.trajectory == SynthTrajectory::kHandheld
+                                             ? std::optional<double>(camera_path.mean_heading())
+                                             : std::nullopt;
     bodies.emplace_back(b, opts.seed, b < options.carried_objects, room, sector);
     const uint64_t body_seed = synth::mix_hash(opts.seed, 0xB0D7u, static_cast<uint64_t>(b));
     const BodyLook look = body_look(body_seed);
@@ -241,7 +279,7 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
         label = kSynthLabelCarried;
       }
       boxes.push_back(make_box(rest[p].half_extents, false, label, recipe, kBodyTexelsPerMetre,
-                               synth::mix_hash(body_seed, p)));
+                               synth::mix_hash(body_seed, p), nullptr));
     }
     body_boxes.push_back(std::move(boxes));
   }
@@ -252,11 +290,19 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
   for (int y = 0; y < camera.height; ++y) {
     row_yn.push_back(static_cast<float>((y - camera.cy) / camera.fy));
   }
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      ray_length.push_back(
+          std::sqrt(column_xn[static_cast<size_t>(x)] * column_xn[static_cast<size_t>(x)] +
+                    row_yn[static_cast<size_t>(y)] * row_yn[static_cast<size_t>(y)] + 1.0f));
+    }
+  }
 }
 
 BoxSurface SyntheticScene::Impl::make_box(const Eigen::Vector3d& half, bool inside, uint8_t label,
                                           const synth::TextureRecipe* recipe,
-                                          float texels_per_metre, uint64_t seed) {
+                                          float texels_per_metre, uint64_t seed,
+                                          const Pose* static_pose) {
   BoxSurface box;
   box.half_extents = half;
   box.seen_from_inside = inside;
@@ -268,9 +314,25 @@ BoxSurface SyntheticScene::Impl::make_box(const Eigen::Vector3d& half, bool insi
     const uint64_t face_seed = synth::mix_hash(seed, static_cast<uint64_t>(face));
     const synth::TextureRecipe face_recipe =
         recipe ? *recipe : synth::static_surface_recipe(face_seed);
+    cv::Mat image =
+        synth::make_texture_image(face_recipe, width_m, height_m, texels_per_metre, face_seed);
+    if (static_pose) {
+      const Eigen::Vector3d normal = static_pose->linear() * face_normal(face, inside);
+      const int u_axis = (axis + 1) % 3, v_axis = (axis + 2) % 3;
+      Eigen::Vector3d local;
+      local[axis] = (face % 2 ? 1.0 : -1.0) * half[axis];
+      for (int j = 0; j < image.rows; ++j) {
+        auto* row = image.ptr<cv::Vec3b>(j);
+        local[v_axis] = (j + 0.5) / texels_per_metre - half[v_axis];
+        for (int i = 0; i < image.cols; ++i) {
+          local[u_axis] = (i + 0.5) / texels_per_metre - half[u_axis];
+          const float shade = light_at(*static_pose * local, normal);
+          for (int c = 0; c < 3; ++c) row[i][c] = cv::saturate_cast<uchar>(row[i][c] * shade);
+        }
+      }
+    }
     box.face_textures[static_cast<size_t>(face)] = static_cast<int>(textures.size());
-    textures.push_back(
-        synth::make_texture(face_recipe, width_m, height_m, texels_per_metre, face_seed));
+    textures.emplace_back(std::move(image), texels_per_metre);
   }
   return box;
 }
@@ -284,14 +346,15 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
 
   // Gather this frame's boxes with their poses.
   std::vector<std::pair<const BoxSurface*, Pose>> posed;
-  for (size_t i = 0; i < static_boxes.size(); ++i) posed.emplace_back(&static_boxes[i], static_poses[i]);
+  for (size_t i = 0; i < static_boxes.size(); ++i)
+    posed.emplace_back(&static_boxes[i], static_poses[i]);
   std::vector<synth::BodyPartPose> parts;
   for (size_t b = 0; b < bodies.size(); ++b) {
     bodies[b].pose_parts(t, parts);
-    for (size_t p = 0; p < parts.size(); ++p) posed.emplace_back(&body_boxes[b][p], parts[p].T_world_part);
+    for (size_t p = 0; p < parts.size(); ++p)
+      posed.emplace_back(&body_boxes[b][p], parts[p].T_world_part);
   }
 
-  const Eigen::Vector3d light_direction = Eigen::Vector3d(0.3, 0.5, 1.0).normalized();
   std::vector<FrameBox> boxes(posed.size());
   for (size_t i = 0; i < posed.size(); ++i) {
     const auto& [surface, T_world_box] = posed[i];
@@ -303,11 +366,13 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
     box.camera_in_box = T_box_camera.translation().cast<float>();
     box.half = surface->half_extents.cast<float>();
     box.first_surface_id = static_cast<uint16_t>(1 + i * 6);
+    const bool is_static = i < static_boxes.size();
     for (int face = 0; face < 6; ++face) {
-      Eigen::Vector3d normal = T_world_box.linear().col(face / 2) * (face % 2 ? 1.0 : -1.0);
-      if (surface->seen_from_inside) normal = -normal;
+      const Eigen::Vector3d normal = face_normal(face, surface->seen_from_inside);
+      const Eigen::Vector3d centre =
+          normal.cwiseAbs().cwiseProduct(surface->half_extents).cwiseProduct(normal);
       box.face_light[static_cast<size_t>(face)] =
-          static_cast<float>(0.6 + 0.3 * std::max(0.0, normal.dot(light_direction)));
+          is_static ? 1.0f : light_at(T_world_box * centre, T_world_box.linear() * normal);
     }
     // Screen rectangle of the box clipped to the near plane (corners in front of it plus
     // points where edges cross it); boxes wholly behind the camera get an empty rectangle.
@@ -355,9 +420,6 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
   frame.labels.create(height, width, CV_8U);
   frame.surface_ids.create(height, width, CV_16U);
   cv::Mat incidence_cos(height, width, CV_32F);
-  const Eigen::Matrix3f R_world_camera = frame.T_world_camera.linear().cast<float>();
-  const Eigen::Vector3f t_world_camera = frame.T_world_camera.translation().cast<float>();
-  const Eigen::Vector3f light_a(2.3f, 3.0f, 2.6f), light_b(4.9f, 3.0f, 2.6f);
   const float focal = static_cast<float>(camera.fx);
 
   parallel_rows(height, threads, [&](int row_begin, int row_end) {
@@ -374,7 +436,8 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
       for (int y = y_begin; y < y_end; ++y) {
         float* depth_row = frame.depth.ptr<float>(y);
         uint16_t* id_row = frame.surface_ids.ptr<uint16_t>(y);
-        const Eigen::Vector3f row_part = box.R_box_camera.col(1) * row_yn[y] + box.R_box_camera.col(2);
+        const Eigen::Vector3f row_part =
+            box.R_box_camera.col(1) * row_yn[y] + box.R_box_camera.col(2);
         for (int x = box.x0; x < box.x1; ++x) {
           const Eigen::Vector3f d = box.R_box_camera.col(0) * column_xn[x] + row_part;
           float t_enter = kNearPlane_m, t_exit = depth_row[x];
@@ -429,17 +492,17 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
         const Eigen::Vector3f p = box.camera_in_box + z * d;
         const float s = p[(axis + 1) % 3] + box.half[(axis + 1) % 3];
         const float r = p[(axis + 2) % 3] + box.half[(axis + 2) % 3];
-        const float ray_length = d.norm();
-        const float cosine = std::abs(d[axis]) / ray_length;
-        const float footprint = z * ray_length / (focal * std::sqrt(std::max(cosine, 0.05f)));
-        const cv::Vec3f albedo =
-            textures[static_cast<size_t>(box.surface->face_textures[static_cast<size_t>(face)])]
-                .sample(s, r, footprint);
-        // View-independent light: the face's diffuse term plus two ceiling lamps.
-        const Eigen::Vector3f world = R_world_camera * Eigen::Vector3f(xn * z, yn * z, z) + t_world_camera;
-        const float lamp = 0.35f / (1.0f + (world - light_a).squaredNorm() / 3.0f) +
-                           0.35f / (1.0f + (world - light_b).squaredNorm() / 3.0f);
-        const float shade = box.face_light[static_cast<size_t>(face)] + lamp;
+        // Mip level from the pixel's footprint on the surface: range / focal, stretched by
+        // 1 / sqrt(cos) (a compromise between blur and aliasing on oblique surfaces).
+        const float length = ray_length[static_cast<size_t>(y * width + x)];
+        const float cosine = std::abs(d[axis]) / length;
+        const synth::MipTexture& texture =
+            textures[static_cast<size_t>(box.surface->face_textures[static_cast<size_t>(face)])];
+        const float lod =
+            synth::MipTexture::approx_log2(z * length * texture.texels_per_metre() / focal) -
+            0.5f * synth::MipTexture::approx_log2(std::max(cosine, 0.05f));
+        const cv::Vec3f albedo = texture.sample_lod(s, r, lod);
+        const float shade = box.face_light[static_cast<size_t>(face)];
         colour_row[x] = cv::Vec3b(cv::saturate_cast<uchar>(albedo[0] * shade),
                                   cv::saturate_cast<uchar>(albedo[1] * shade),
                                   cv::saturate_cast<uchar>(albedo[2] * shade));

@@ -26,8 +26,8 @@ std::string to_string(SynthTrajectory trajectory);
 
 struct SynthOptions {
   size_t frames = 300;
-  int bodies = 3;            // walking people; 0 = the static twin (same room, same camera path)
-  int carried_objects = 1;   // people carrying a box; clamped to `bodies`
+  int bodies = 3;           // walking people; 0 = the static twin (same room, same camera path)
+  int carried_objects = 1;  // people carrying a box; clamped to `bodies`
   uint64_t seed = 1;
   SynthTrajectory trajectory = SynthTrajectory::kHandheld;
   // Kinect-like sensor: noise growing with depth squared plus holes (range limits, grazing
@@ -43,7 +43,7 @@ struct SynthFrame {
   size_t index = 0;
   Timestamp timestamp = 0.0;
   Pose T_world_camera = Pose::Identity();  // exact ground truth, camera-to-world
-  cv::Mat bgr;           // CV_8UC3
+  cv::Mat bgr;                             // CV_8UC3
   cv::Mat depth;         // CV_32F metres, exact z-depth of every pixel (the room is closed)
   cv::Mat depth_sensor;  // CV_32F metres, exactly what depth/<ts>.png holds (0 = no reading)
   cv::Mat labels;        // CV_8U, kSynthLabel* values

@@ -20,9 +20,7 @@ float axial_sigma(float z) {
   return 0.0012f + 0.0019f * d * d;
 }
 
-bool is_jump(float a, float b) {
-  return std::abs(a - b) > 0.02f + 0.02f * std::min(a, b);
-}
+bool is_jump(float a, float b) { return std::abs(a - b) > 0.02f + 0.02f * std::min(a, b); }
 
 }  // namespace
 

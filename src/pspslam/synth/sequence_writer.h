@@ -16,7 +16,8 @@ using SynthProgress = std::function<void(size_t frames_done)>;
 // Renders every frame and writes the TUM layout into `dir` (created when missing):
 //   rgb/<ts>.png, depth/<ts>.png (16-bit, 5000 per metre, 0 = no reading), mask/<ts>.png
 //   (8-bit kSynthLabel* values), rgb.txt, depth.txt, mask.txt, groundtruth.txt (camera-to-world),
-//   config.yaml (save_config of synthetic_system_config()), info.yaml (generator parameters).
+//   config.yaml (save_config of synthetic_system_config()), info.yaml (generator parameters),
+//   README.txt (what the files are).
 // Frames are rendered and encoded in parallel (options().threads workers); the output bytes do
 // not depend on the thread count. Throws pspslam::Error naming the path that cannot be written.
 void write_sequence(const SyntheticScene& scene, const std::filesystem::path& dir,

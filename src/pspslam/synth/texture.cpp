@@ -10,7 +10,8 @@ namespace {
 
 cv::Scalar random_colour(cv::RNG& rng, double saturation) {
   // Mix a random colour with its own grey so `saturation` controls how colourful accents are.
-  const double r = rng.uniform(0.0, 255.0), g = rng.uniform(0.0, 255.0), b = rng.uniform(0.0, 255.0);
+  const double r = rng.uniform(0.0, 255.0), g = rng.uniform(0.0, 255.0),
+               b = rng.uniform(0.0, 255.0);
   const double grey = (r + g + b) / 3.0;
   return cv::Scalar(grey + (b - grey) * saturation, grey + (g - grey) * saturation,
                     grey + (r - grey) * saturation);
@@ -29,9 +30,10 @@ cv::Mat value_noise(int width, int height, float texels_per_metre, cv::RNG& rng)
     cv::Mat grid(grid_h, grid_w, CV_32F);
     rng.fill(grid, cv::RNG::UNIFORM, 0.0, 1.0);
     cv::Mat up;
-    cv::resize(grid, up, cv::Size(static_cast<int>(grid_w * cell_texels),
-                                  static_cast<int>(grid_h * cell_texels)),
-               0, 0, cv::INTER_CUBIC);
+    cv::resize(
+        grid, up,
+        cv::Size(static_cast<int>(grid_w * cell_texels), static_cast<int>(grid_h * cell_texels)), 0,
+        0, cv::INTER_CUBIC);
     sum += up(cv::Rect(0, 0, width, height)) * weights[octave];
   }
   double lo = 0, hi = 1;
@@ -61,8 +63,8 @@ TextureRecipe static_surface_recipe(uint64_t seed) {
   return recipe;
 }
 
-MipTexture make_texture(const TextureRecipe& recipe, double width_m, double height_m,
-                        float texels_per_metre, uint64_t seed) {
+cv::Mat make_texture_image(const TextureRecipe& recipe, double width_m, double height_m,
+                           float texels_per_metre, uint64_t seed) {
   cv::RNG rng(mix_hash(seed));
   const int width = std::max(4, static_cast<int>(std::ceil(width_m * texels_per_metre)));
   const int height = std::max(4, static_cast<int>(std::ceil(height_m * texels_per_metre)));
@@ -75,7 +77,8 @@ MipTexture make_texture(const TextureRecipe& recipe, double width_m, double heig
     for (int x = 0; x < width; ++x) {
       const double w = std::clamp(0.5 + (n[x] - 0.5) * 1.6 * recipe.noise_contrast, 0.0, 1.0);
       for (int c = 0; c < 3; ++c) {
-        out[x][c] = cv::saturate_cast<uchar>(recipe.colour_a[c] * (1.0 - w) + recipe.colour_b[c] * w);
+        out[x][c] =
+            cv::saturate_cast<uchar>(recipe.colour_a[c] * (1.0 - w) + recipe.colour_b[c] * w);
       }
     }
   }
@@ -112,7 +115,8 @@ MipTexture make_texture(const TextureRecipe& recipe, double width_m, double heig
     const double length = metres(0.05, 0.5);
     const cv::Point b(a.x + static_cast<int>(length * std::cos(angle)),
                       a.y + static_cast<int>(length * std::sin(angle)));
-    const cv::Scalar colour = rng.uniform(0, 2) ? cv::Scalar(20, 20, 20) : cv::Scalar(235, 235, 235);
+    const cv::Scalar colour =
+        rng.uniform(0, 2) ? cv::Scalar(20, 20, 20) : cv::Scalar(235, 235, 235);
     cv::line(image, a, b, colour, std::max(1, metres(0.003, 0.012)), cv::LINE_AA);
   }
   static constexpr char kGlyphs[] = "ABCDEFGHKLMNPRSTUVWXYZ0123456789#%&";
@@ -121,11 +125,12 @@ MipTexture make_texture(const TextureRecipe& recipe, double width_m, double heig
     for (int k = rng.uniform(2, 6); k > 0; --k) text += kGlyphs[rng.uniform(0, 35)];
     const double glyph_height = metres(0.025, 0.09);
     const double scale = glyph_height / 22.0;  // FONT_HERSHEY_SIMPLEX is ~22 px tall at scale 1
-    const cv::Scalar colour = rng.uniform(0, 2) ? cv::Scalar(15, 15, 15) : cv::Scalar(245, 245, 245);
+    const cv::Scalar colour =
+        rng.uniform(0, 2) ? cv::Scalar(15, 15, 15) : cv::Scalar(245, 245, 245);
     cv::putText(image, text, point(), cv::FONT_HERSHEY_SIMPLEX, scale, colour,
                 std::max(1, static_cast<int>(glyph_height / 10)), cv::LINE_AA);
   }
-  return MipTexture(image, texels_per_metre);
+  return image;
 }
 
 MipTexture::MipTexture(cv::Mat level0_bgr, float texels_per_metre)

@@ -13,12 +13,12 @@ namespace pspslam::synth {
 struct TextureRecipe {
   cv::Vec3b colour_a{0, 0, 0};
   cv::Vec3b colour_b{255, 255, 255};
-  double noise_contrast = 1.0;   // 0..1: how far the value noise spreads between the two colours
-  double blobs_per_m2 = 20.0;    // filled ellipses of random colour
-  double lines_per_m2 = 10.0;    // straight strokes
-  double rects_per_m2 = 3.0;     // tiles / posters / labels
-  double glyphs_per_m2 = 4.0;    // short strings of letters: sharp corners at many scales
-  double saturation = 1.0;       // 0 = grey accents, 1 = colourful accents
+  double noise_contrast = 1.0;  // 0..1: how far the value noise spreads between the two colours
+  double blobs_per_m2 = 20.0;   // filled ellipses of random colour
+  double lines_per_m2 = 10.0;   // straight strokes
+  double rects_per_m2 = 3.0;    // tiles / posters / labels
+  double glyphs_per_m2 = 4.0;   // short strings of letters: sharp corners at many scales
+  double saturation = 1.0;      // 0 = grey accents, 1 = colourful accents
 };
 
 // Random recipe for a static surface (wall, floor, furniture): every surface gets its own.
@@ -31,10 +31,22 @@ class MipTexture {
  public:
   MipTexture(cv::Mat level0_bgr, float texels_per_metre);
 
+  float texels_per_metre() const { return texels_per_metre_; }
+
+  // Piecewise-linear log2 from the float's bits (error < 0.09): plenty to pick a mip level.
+  static float approx_log2(float x) {
+    x = std::max(x, 1e-20f);
+    return static_cast<float>(std::bit_cast<uint32_t>(x)) * (1.0f / (1 << 23)) - 127.0f;
+  }
+
   // Trilinear sample. `footprint_m` is the size of one image pixel on the surface in metres.
-  // Inline: called once per pixel of every frame.
   cv::Vec3f sample(float s_m, float t_m, float footprint_m) const {
-    const float lod = approx_log2(footprint_m * texels_per_metre_);
+    return sample_lod(s_m, t_m, approx_log2(footprint_m * texels_per_metre_));
+  }
+
+  // Same with the level of detail (log2 of the footprint in level-0 texels) given.
+  // Inline: called once per pixel of every frame.
+  cv::Vec3f sample_lod(float s_m, float t_m, float lod) const {
     const int max_level = static_cast<int>(levels_.size()) - 1;
     if (lod <= 0.0f) return at_level(0, s_m, t_m);
     if (lod >= static_cast<float>(max_level)) return at_level(max_level, s_m, t_m);
@@ -48,12 +60,6 @@ class MipTexture {
   }
 
  private:
-  // Piecewise-linear log2 from the float's bits (error < 0.09): plenty to pick a mip level.
-  static float approx_log2(float x) {
-    x = std::max(x, 1e-20f);
-    return static_cast<float>(std::bit_cast<uint32_t>(x)) * (1.0f / (1 << 23)) - 127.0f;
-  }
-
   cv::Vec3f at_level(int level, float s_m, float t_m) const {
     const float scale = texels_per_metre_ / static_cast<float>(1 << level);
     // pyrDown keeps texel centres at (2i + 0.5): coordinates scale with the level, minus 0.5.
@@ -81,10 +87,11 @@ class MipTexture {
   float texels_per_metre_;
 };
 
-// Renders a texture covering width_m x height_m metres at `texels_per_metre`, deterministic in
-// `seed` (cv::RNG and OpenCV drawing are platform independent).
-MipTexture make_texture(const TextureRecipe& recipe, double width_m, double height_m,
-                        float texels_per_metre, uint64_t seed);
+// Draws the level-0 image (CV_8UC3) of a texture covering width_m x height_m metres at
+// `texels_per_metre`, deterministic in `seed` (cv::RNG and OpenCV drawing are platform
+// independent). Texel (i, j) covers surface coordinates [i, i+1) x [j, j+1) / texels_per_metre.
+cv::Mat make_texture_image(const TextureRecipe& recipe, double width_m, double height_m,
+                           float texels_per_metre, uint64_t seed);
 
 // splitmix64: the one hash used for every derived seed and per-pixel random number, so results
 // depend on (seed, what, where) only and never on thread scheduling.

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 
@@ -29,6 +30,12 @@
 
 namespace pspslam {
 namespace {
+
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
 
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -128,14 +135,18 @@ FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Ma
                           const cv::Mat& dynamic_mask) {
   FrameReport report;
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_ms();
   OrbFeatures features;
   extractor_->extract(gray, dynamic_mask, features);
   Frame frame(next_frame_id_++, timestamp, std::move(features.keypoints),
               std::move(features.descriptors), depth_metres, camera_, pyramid_);
   report.extraction_ms = milliseconds_since(start);
+  const double cpu_tracking_start = thread_cpu_ms();
+  report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(frame));
   report.tracking_ms = milliseconds_since(tracking_start);
+  report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
   return report;
 }
 

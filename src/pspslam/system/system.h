@@ -29,6 +29,10 @@ struct FrameReport {
   TrackResult tracking;
   double extraction_ms = 0.0;
   double tracking_ms = 0.0;
+  // CPU time of the calling thread: on a shared, loaded machine wall time includes waiting
+  // for a core, CPU time does not.
+  double extraction_cpu_ms = 0.0;
+  double tracking_cpu_ms = 0.0;
 };
 
 struct MappingStats {
@@ -60,6 +64,9 @@ class System {
 
   // Keyframe poses (T_world_camera), by keyframe id.
   Trajectory keyframe_trajectory() const;
+  // All tracked frames, re-expressed through their BA-refined reference keyframes (see
+  // Tracker::refined_trajectory); call after shutdown().
+  Trajectory refined_trajectory() const { return tracker_->refined_trajectory(); }
   MappingStats mapping_stats() const;
   const Map& map() const { return *map_; }
 

@@ -99,6 +99,9 @@ TrackResult Tracker::track(Frame frame) {
       velocity_.reset();
     }
     last_tracked_pose_ = frame.T_camera_world();
+    anchors_.push_back({frame.timestamp(), reference_keyframe_,
+                        frame.T_camera_world() * reference_keyframe_->T_world_camera(),
+                        frame.T_camera_world()});
   } else {
     velocity_.reset();
   }
@@ -108,6 +111,19 @@ TrackResult Tracker::track(Frame frame) {
   }
   last_frame_.emplace(std::move(frame));
   return result;
+}
+
+Trajectory Tracker::refined_trajectory() const {
+  Trajectory trajectory;
+  trajectory.reserve(anchors_.size());
+  for (const FrameAnchor& anchor : anchors_) {
+    const auto reference = anchor.reference.lock();
+    const Pose T_camera_world = reference && !reference->is_bad()
+                                    ? anchor.T_camera_reference * reference->T_camera_world()
+                                    : anchor.T_camera_world;
+    trajectory.push_back({anchor.timestamp, T_camera_world.inverse()});
+  }
+  return trajectory;
 }
 
 bool Tracker::initialize(Frame& frame) {

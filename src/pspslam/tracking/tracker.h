@@ -68,6 +68,12 @@ class Tracker {
 
   TrackResult track(Frame frame);
 
+  // Every tracked frame's pose re-expressed through its reference keyframe as local mapping
+  // has refined it since (ORB-SLAM2's saved trajectory): T_camera_world = T_camera_reference *
+  // T_reference_world(now). Frames whose reference keyframe was culled keep their tracked pose.
+  // Lost frames are absent, as in track(). Call when local mapping is idle or stopped.
+  Trajectory refined_trajectory() const;
+
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
 
@@ -96,6 +102,14 @@ class Tracker {
   std::uint64_t last_keyframe_frame_id_ = 0;
   std::uint64_t last_recovery_frame_id_ = 0;
   LocalMap local_map_;
+
+  struct FrameAnchor {
+    Timestamp timestamp = 0.0;
+    std::weak_ptr<KeyFrame> reference;
+    Pose T_camera_reference;
+    Pose T_camera_world;  // as tracked
+  };
+  std::vector<FrameAnchor> anchors_;
 
   // Reused per-frame buffers (no allocation per keypoint).
   std::vector<PoseObservation> observations_;

@@ -6,7 +6,7 @@
 #include <random>
 
 #include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/geometry/synthetic_scene.h"
+#include "pspslam/geometry/test_scene.h"
 
 namespace {
 
@@ -26,9 +26,9 @@ struct Frame {
 const Frame& frame() {
   static const Frame f = [] {
     Frame out;
-    SyntheticSceneParams sp;
+    GeometryTestSceneParams sp;
     sp.seed = 1;
-    const SyntheticScene scene(sp);
+    const GeometryTestScene scene(sp);
     out.camera = sp.camera;
     const int current = 64;
     for (int k = 1; k <= 5; ++k) {
@@ -94,9 +94,12 @@ void BM_Search(benchmark::State& state) {
   MultiViewTest test(f.camera, MultiViewParams{});
   test.set_frame(f.T_world_camera, f.references);
   const PointPredicate predicate = [&](int i) { return test.is_dynamic(f.candidates[i]); };
-  int tested = 0;
-  for (auto _ : state) tested = search.run(f.points, f.depth.size(), predicate).tested_count;
-  state.counters["tested"] = tested;
+  const SearchResult* result = nullptr;
+  for (auto _ : state) result = &search.run(f.points, f.depth.size(), predicate);
+  state.counters["tested"] = result->tested_count;
+  state.counters["dynamic"] = result->dynamic_count;
+  state.counters["communities"] = result->communities;
+  state.counters["rounds"] = result->band_rounds;
 }
 BENCHMARK(BM_Search)->Arg(0)->Arg(1)->ArgNames({"exhaustive"})->Unit(benchmark::kMicrosecond);
 

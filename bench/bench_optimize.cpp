@@ -16,7 +16,8 @@ constexpr double kBaseline = 0.08;
 
 Pose camera_on_track(int index) {
   Pose T_world_camera = Pose::Identity();
-  T_world_camera.linear() = Eigen::AngleAxisd(0.02 * index, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_world_camera.linear() =
+      Eigen::AngleAxisd(0.02 * index, Eigen::Vector3d::UnitY()).toRotationMatrix();
   T_world_camera.translation() = Eigen::Vector3d(0.1 * index, 0.0, 0.0);
   return T_world_camera.inverse();
 }
@@ -24,8 +25,9 @@ Pose camera_on_track(int index) {
 Pose perturbed(const Pose& pose, std::mt19937& rng, double angle, double shift) {
   std::normal_distribution<double> normal(0.0, 1.0);
   Pose delta = Pose::Identity();
-  delta.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized())
-                       .toRotationMatrix();
+  delta.linear() =
+      Eigen::AngleAxisd(angle, Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized())
+          .toRotationMatrix();
   delta.translation() = shift * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
   return delta * pose;
 }
@@ -97,7 +99,8 @@ void BM_LocalBundleAdjustment(benchmark::State& state) {
     }
   }
   for (BaKeyframe& keyframe : start.keyframes) {
-    if (!keyframe.fixed) keyframe.T_camera_world = perturbed(keyframe.T_camera_world, rng, 0.005, 0.02);
+    if (!keyframe.fixed)
+      keyframe.T_camera_world = perturbed(keyframe.T_camera_world, rng, 0.005, 0.02);
   }
   std::normal_distribution<double> point_noise(0.0, 0.02);
   for (BaPoint& point : start.points) {

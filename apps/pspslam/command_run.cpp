@@ -59,6 +59,8 @@ int run_command(const std::vector<std::string>& args) {
                     "else required; presets in config/)");
   parser.add_option("out", "output folder", "pspslam_out");
   parser.add_option("max-frames", "process at most this many frames (0 = all)", "0");
+  parser.add_switch("no-local-mapping",
+                    "track only: keyframes enter the map but are never refined (debugging)");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
   if (max_frames_flag < 0) throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
@@ -83,7 +85,9 @@ int run_command(const std::vector<std::string>& args) {
             "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms\n";
   std::cout << describe_sequence(setup);
 
-  System system(setup.config);
+  SystemOptions system_options;
+  system_options.local_mapping = !parser.flag("no-local-mapping");
+  System system(setup.config, system_options);
   InterruptGuard interrupt_guard;
   ProgressBar progress("slam", frames, std::cerr);
   std::vector<double> extraction_ms;
@@ -151,6 +155,12 @@ int run_command(const std::vector<std::string>& args) {
                 seconds > 0 ? processed / seconds : 0.0, seconds, median(extraction_ms),
                 median(tracking_ms), median(tracking_cpu_ms), mapping.keyframes_in_map, mapping.map_points,
                 mapping.max_queued_keyframes, mapping.local_ba_ms_total);
+  std::cout << line;
+  std::snprintf(line, sizeof(line),
+                "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
+                "%zu fused, %zu culled, %zu BA outlier observations removed\n",
+                mapping.processed_keyframes, mapping.keyframes_culled, mapping.points_triangulated,
+                mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed);
   std::cout << line;
   std::cout << "output:       " << (out_dir / "trajectory.txt").string() << " ("
             << trajectory.count()

@@ -3,30 +3,20 @@
 #include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
 #include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/geometry/synthetic_scene.h"
+#include "pspslam/geometry/test_scene.h"
 
 namespace pspslam {
 namespace {
 
-PinholeCamera small_camera() {
-  PinholeCamera c;
-  c.width = 320;
-  c.height = 240;
-  c.fx = c.fy = 262.5;
-  c.cx = 159.5;
-  c.cy = 119.5;
-  return c;
-}
 
 struct Rendered {
   cv::Mat depth, labels;
 };
 
-TEST(GeometryStage, DetectsPeopleAndCarriedBoxInSyntheticScene) {
-  SyntheticSceneParams scene_params;
-  scene_params.camera = small_camera();
+TEST(GeometryStage, DetectsPeopleAndCarriedBoxInGeometryTestScene) {
+  GeometryTestSceneParams scene_params;
   scene_params.seed = 3;
-  const SyntheticScene scene(scene_params);
+  const GeometryTestScene scene(scene_params);
   const int current = 40;
   std::vector<DepthView> references;
   std::vector<Rendered> keep;
@@ -38,14 +28,9 @@ TEST(GeometryStage, DetectsPeopleAndCarriedBoxInSyntheticScene) {
   }
   Rendered now;
   scene.render(current, now.depth, now.labels);
-  const std::vector<Eigen::Vector2d> keypoints = sample_candidate_pixels(now.depth, 600, 11);
+  const std::vector<Eigen::Vector2d> keypoints = sample_candidate_pixels(now.depth, 1000, 11);
 
-  GeometryParams params;
-  params.search.search_radius_px = 6.0f;  // half-resolution image: half the pixel distances
-  params.search.node_spacing_px = 8.0f;
-  params.search.lane_spacing_px = 24.0f;
-  params.search.band_width_px = 10.0f;
-  GeometryStage stage(scene_params.camera, params);
+  GeometryStage stage(scene_params.camera, GeometryParams{});
   GeometryFrameInput input;
   input.depth = now.depth;
   input.T_world_camera = scene.camera_pose(current);

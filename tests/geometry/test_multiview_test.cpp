@@ -87,6 +87,7 @@ TEST(MultiViewTest, VoteFraction) {
   scene.references.push_back({translated(0.05), with_person});
   scene.references.push_back({translated(0.1), cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f))});
   MultiViewParams majority;
+  majority.min_dynamic_vote_fraction = 0.5;
   MultiViewTest test(camera(), majority);
   test.set_frame(scene.T_world_current, scene.references);
   const MultiViewVerdict v = test.evaluate({{320.0, 240.0}, 2.0});
@@ -98,6 +99,13 @@ TEST(MultiViewTest, VoteFraction) {
   MultiViewTest strict(camera(), unanimous);
   strict.set_frame(scene.T_world_current, scene.references);
   EXPECT_FALSE(strict.is_dynamic({{320.0, 240.0}, 2.0}));
+  // The default (0.2, "any one of up to 5") stops at the first dynamic vote.
+  MultiViewTest any(camera(), MultiViewParams{});
+  any.set_frame(scene.T_world_current, scene.references);
+  const MultiViewVerdict first = any.evaluate({{320.0, 240.0}, 2.0});
+  EXPECT_TRUE(first.dynamic);
+  EXPECT_EQ(first.dynamic_votes, 1);
+  EXPECT_EQ(first.valid_references, 1);
 }
 
 TEST(MultiViewTest, ParamsFromYamlNameTheKey) {

@@ -124,8 +124,7 @@ Pose perturbed(const Pose& pose, double angle_rad, double translation_m, std::mt
 }
 
 double rotation_error_deg(const Pose& a, const Pose& b) {
-  return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * 180.0 /
-         std::numbers::pi;
+  return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * 180.0 / std::numbers::pi;
 }
 
 double center_error(const Pose& T_camera_world_a, const Pose& T_camera_world_b) {

@@ -19,7 +19,7 @@ namespace pspslam::testing {
 
 struct WorldPoint {
   Eigen::Vector3d position;
-  cv::Mat descriptor;  // 1×32 CV_8U
+  cv::Mat descriptor;     // 1×32 CV_8U
   bool has_depth = true;  // false: the sensor returns no depth there (needs triangulation)
   std::int64_t only_in_keyframe = -1;  // >= 0: a transient feature seen by that keyframe only
 };

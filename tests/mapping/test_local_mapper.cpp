@@ -51,7 +51,8 @@ PathRun run_path(SyntheticWorld& world, int num_keyframes) {
   std::uniform_real_distribution<double> pixel_x(40.0, 600.0), pixel_y(40.0, 440.0);
   for (int k = 0; k < num_keyframes; ++k) {
     run.truth.push_back(testing::path_pose(k));
-    run.initial.push_back(k == 0 ? run.truth[k] : testing::perturbed(run.truth[k], 0.0087, 0.03, rng));
+    run.initial.push_back(k == 0 ? run.truth[k]
+                                 : testing::perturbed(run.truth[k], 0.0087, 0.03, rng));
     for (int t = 0; t < 30; ++t) {
       const Eigen::Vector3d in_camera =
           world.camera()->pinhole.unproject({pixel_x(rng), pixel_y(rng)}, 2.0);
@@ -84,7 +85,8 @@ TEST(LocalMapper, BuildsCullsAndOptimisesASyntheticMap) {
   }
   int stale_transients = 0;
   for (int k = 0; k + 2 < num_keyframes; ++k) {
-    for (int t = 0; t < 30; ++t) stale_transients += mapped_world_points.contains(run.transient_points[k * 30 + t]);
+    for (int t = 0; t < 30; ++t)
+      stale_transients += mapped_world_points.contains(run.transient_points[k * 30 + t]);
   }
   EXPECT_EQ(stale_transients, 0);
 

@@ -30,13 +30,15 @@ BaScene make_scene(int num_keyframes, int num_fixed, int num_points, double dept
   const double bf = test_bf(camera);
   BaScene scene;
   for (int k = 0; k < num_keyframes; ++k) {
-    const Pose T_world_camera =
-        testing::make_pose(Eigen::Vector3d(0.0, 0.02 * k, 0.0), Eigen::Vector3d(0.15 * k, 0.0, 0.0));
-    scene.truth.keyframes.push_back({static_cast<uint64_t>(k), T_world_camera.inverse(), k < num_fixed});
+    const Pose T_world_camera = testing::make_pose(Eigen::Vector3d(0.0, 0.02 * k, 0.0),
+                                                   Eigen::Vector3d(0.15 * k, 0.0, 0.0));
+    scene.truth.keyframes.push_back(
+        {static_cast<uint64_t>(k), T_world_camera.inverse(), k < num_fixed});
   }
   std::uniform_real_distribution<double> x(-2.0, 3.0), y(-1.5, 1.5), z(2.0, 6.0);
   for (int p = 0; p < num_points; ++p) {
-    scene.truth.points.push_back({static_cast<uint64_t>(p), Eigen::Vector3d(x(rng), y(rng), z(rng))});
+    scene.truth.points.push_back(
+        {static_cast<uint64_t>(p), Eigen::Vector3d(x(rng), y(rng), z(rng))});
   }
 
   scene.problem = scene.truth;
@@ -47,9 +49,9 @@ BaScene make_scene(int num_keyframes, int num_fixed, int num_points, double dept
     for (size_t p = 0; p < scene.truth.points.size(); ++p) {
       const Eigen::Vector3d point_camera = T_camera_world * scene.truth.points[p].position_world;
       if (point_camera.z() < 0.1 || !camera.in_image(camera.project(point_camera), 10.0)) continue;
-      auto measurement = testing::measure(camera, bf, T_camera_world,
-                                          scene.truth.points[p].position_world, has_depth(rng),
-                                          1.0, 2, rng);
+      auto measurement =
+          testing::measure(camera, bf, T_camera_world, scene.truth.points[p].position_world,
+                           has_depth(rng), 1.0, 2, rng);
       const bool outlier = is_outlier(rng);
       if (outlier) measurement.pixel = {u(rng), v(rng)};
       scene.problem.observations.push_back(
@@ -59,7 +61,8 @@ BaScene make_scene(int num_keyframes, int num_fixed, int num_points, double dept
   }
 
   for (BaKeyframe& keyframe : scene.problem.keyframes) {
-    if (!keyframe.fixed) keyframe.T_camera_world = testing::perturb(keyframe.T_camera_world, 1.0, 0.05, rng);
+    if (!keyframe.fixed)
+      keyframe.T_camera_world = testing::perturb(keyframe.T_camera_world, 1.0, 0.05, rng);
   }
   std::normal_distribution<double> point_noise(0.0, 0.03);
   for (BaPoint& point : scene.problem.points) {
@@ -76,8 +79,8 @@ double rms_whitened_reprojection(const BaProblem& problem, const std::vector<uin
   for (size_t i = 0; i < problem.observations.size(); ++i) {
     if (!inlier[i]) continue;
     const BaObservation& o = problem.observations[i];
-    const Eigen::Vector2d projected = camera.project(
-        problem.keyframes[o.keyframe].T_camera_world * problem.points[o.point].position_world);
+    const Eigen::Vector2d projected = camera.project(problem.keyframes[o.keyframe].T_camera_world *
+                                                     problem.points[o.point].position_world);
     sum += (o.pixel - projected).squaredNorm() * o.information;
     count += 2;
   }
@@ -87,8 +90,8 @@ double rms_whitened_reprojection(const BaProblem& problem, const std::vector<uin
 double max_pose_rotation_error(const BaProblem& a, const BaProblem& b) {
   double worst = 0.0;
   for (size_t k = 0; k < a.keyframes.size(); ++k) {
-    worst = std::max(worst, rotation_error_deg(a.keyframes[k].T_camera_world,
-                                               b.keyframes[k].T_camera_world));
+    worst = std::max(
+        worst, rotation_error_deg(a.keyframes[k].T_camera_world, b.keyframes[k].T_camera_world));
   }
   return worst;
 }
@@ -96,8 +99,8 @@ double max_pose_rotation_error(const BaProblem& a, const BaProblem& b) {
 double max_pose_translation_error(const BaProblem& a, const BaProblem& b) {
   double worst = 0.0;
   for (size_t k = 0; k < a.keyframes.size(); ++k) {
-    worst = std::max(worst, translation_error(a.keyframes[k].T_camera_world,
-                                              b.keyframes[k].T_camera_world));
+    worst = std::max(
+        worst, translation_error(a.keyframes[k].T_camera_world, b.keyframes[k].T_camera_world));
   }
   return worst;
 }
@@ -127,11 +130,12 @@ void expect_ba_converges(double depth_fraction, double max_translation_error, ui
   EXPECT_LT(max_pose_translation_error(scene.problem, scene.truth), max_translation_error);
   for (size_t k = 0; k < scene.problem.keyframes.size(); ++k) {
     if (!scene.problem.keyframes[k].fixed) continue;
-    EXPECT_TRUE(scene.problem.keyframes[k].T_camera_world.isApprox(start.keyframes[k].T_camera_world,
-                                                                   0.0))
+    EXPECT_TRUE(
+        scene.problem.keyframes[k].T_camera_world.isApprox(start.keyframes[k].T_camera_world, 0.0))
         << "fixed keyframe " << k << " moved";
   }
-  const auto kept = std::count(result.observation_inlier.begin(), result.observation_inlier.end(), 1);
+  const auto kept =
+      std::count(result.observation_inlier.begin(), result.observation_inlier.end(), 1);
   EXPECT_GT(kept, 0.9 * static_cast<double>(result.observation_inlier.size()));
 }
 
@@ -140,8 +144,8 @@ TEST(LocalBundleAdjustment, ExactMeasurementsRecoverTheTruth) {
   const PinholeCamera camera = test_camera();
   const double bf = test_bf(camera);
   for (BaObservation& o : scene.problem.observations) {  // remove the noise
-    const Eigen::Vector3d p =
-        scene.truth.keyframes[o.keyframe].T_camera_world * scene.truth.points[o.point].position_world;
+    const Eigen::Vector3d p = scene.truth.keyframes[o.keyframe].T_camera_world *
+                              scene.truth.points[o.point].position_world;
     o.pixel = camera.project(p);
     if (o.right_u >= 0.0) o.right_u = o.pixel.x() - bf / p.z();
   }
@@ -158,15 +162,17 @@ TEST(LocalBundleAdjustment, ExactMeasurementsRecoverTheTruth) {
   double worst_point_error = 0.0;
   for (size_t p = 0; p < scene.truth.points.size(); ++p) {
     if (constraints[p] < 2) continue;
-    worst_point_error = std::max(worst_point_error, (scene.problem.points[p].position_world -
-                                                     scene.truth.points[p].position_world)
-                                                        .norm());
+    worst_point_error = std::max(
+        worst_point_error,
+        (scene.problem.points[p].position_world - scene.truth.points[p].position_world).norm());
   }
   EXPECT_LT(worst_point_error, 1e-5);
   EXPECT_LT(result.final_cost, 1e-8);
 }
 
-TEST(LocalBundleAdjustment, RgbdObservationsConvergeToNoiseLevel) { expect_ba_converges(1.0, 0.02, 11); }
+TEST(LocalBundleAdjustment, RgbdObservationsConvergeToNoiseLevel) {
+  expect_ba_converges(1.0, 0.02, 11);
+}
 
 TEST(LocalBundleAdjustment, MixedDepthObservationsConvergeToNoiseLevel) {
   expect_ba_converges(0.5, 0.02, 12);
@@ -202,8 +208,8 @@ TEST(LocalBundleAdjustment, AllKeyframesFixedOptimisesPointsOnly) {
   const PinholeCamera camera = test_camera();
   const BaResult result = solve_bundle_adjustment(scene.problem, camera, test_bf(camera));
   for (size_t k = 0; k < 4; ++k) {
-    EXPECT_TRUE(scene.problem.keyframes[k].T_camera_world.isApprox(start.keyframes[k].T_camera_world,
-                                                                   0.0));
+    EXPECT_TRUE(
+        scene.problem.keyframes[k].T_camera_world.isApprox(start.keyframes[k].T_camera_world, 0.0));
   }
   EXPECT_LT(result.final_cost, 0.1 * result.initial_cost);
   EXPECT_LT(rms_whitened_reprojection(scene.problem, result.observation_inlier), 1.1);

@@ -35,17 +35,18 @@ TEST(PoseManifold, PlusIsLeftMultiplication) {
 }
 
 // The analytic tangent Jacobians of both residual kinds against central differences through Plus.
-template <int kResiduals>
-void check_bundle_jacobians() {
+template <int kDof, ObservationRows kRows>
+void check_bundle_jacobians(double huber_delta) {
   const PinholeCamera camera = testing::test_camera();
   const StereoProjection model = StereoProjection::from(camera, testing::test_bf(camera));
   const PoseManifold manifold;
   const PoseParameters pose =
       PoseParameters::from_pose(testing::make_pose({0.2, 0.1, -0.1}, {0.1, 0.2, 0.3}));
   Eigen::Vector3d point = pose.to_pose().inverse() * Eigen::Vector3d(0.4, -0.3, 2.0);
-  Measurement<kResiduals> measured;
+  Measurement<kDof> measured;
   measured.setConstant(300.0);
-  const BundleReprojectionCost<kResiduals> cost(model, measured, 1.0 / 1.2);
+  const BundleReprojectionCost<kDof, kRows> cost(model, measured, 1.0 / 1.2, huber_delta);
+  constexpr int kResiduals = 2;
 
   Eigen::Matrix<double, kResiduals, 1> residual;
   Eigen::Matrix<double, kResiduals, 7, Eigen::RowMajor> pose_jacobian;
@@ -54,6 +55,20 @@ void check_bundle_jacobians() {
   double* jacobians[] = {pose_jacobian.data(), point_jacobian.data()};
   ASSERT_TRUE(cost.Evaluate(parameters, residual.data(), jacobians));
   EXPECT_EQ(pose_jacobian.col(6).norm(), 0.0);
+  if (kRows == ObservationRows::kRightPadded) {
+    EXPECT_EQ(residual(1), 0.0);
+    EXPECT_EQ(pose_jacobian.row(1).norm() + point_jacobian.row(1).norm(), 0.0);
+  }
+  // Without a kernel the reweighting is exact; with one (IRLS) the Jacobian is √ρ'-weighted and
+  // not the derivative of the scaled residual, so compare against the unweighted derivative.
+  const double jacobian_weight = [&] {
+    if (huber_delta <= 0.0) return 1.0;
+    const Eigen::Vector3d p_c = pose.to_pose() * point;
+    Measurement<kDof> r = Measurement<kDof>::Zero();
+    EXPECT_TRUE(whitened_residual<kDof>(model, measured, 1.0 / 1.2, p_c, r, nullptr));
+    const RobustScaling s = huber_scaling(r.squaredNorm(), huber_delta);
+    return s.jacobian / s.residual;
+  }();
 
   const double step = 1e-6;
   for (int j = 0; j < 6; ++j) {
@@ -69,7 +84,8 @@ void check_bundle_jacobians() {
     cost.Evaluate(p_plus, r_plus.data(), nullptr);
     cost.Evaluate(p_minus, r_minus.data(), nullptr);
     const Eigen::Matrix<double, kResiduals, 1> numeric = (r_plus - r_minus) / (2.0 * step);
-    EXPECT_LT((numeric - pose_jacobian.col(j)).norm(), 1e-4) << "pose tangent column " << j;
+    EXPECT_LT((jacobian_weight * numeric - pose_jacobian.col(j)).norm(), 1e-4)
+        << "pose tangent column " << j;
   }
   for (int j = 0; j < 3; ++j) {
     Eigen::Vector3d plus = point, minus = point;
@@ -81,13 +97,36 @@ void check_bundle_jacobians() {
     cost.Evaluate(p_plus, r_plus.data(), nullptr);
     cost.Evaluate(p_minus, r_minus.data(), nullptr);
     const Eigen::Matrix<double, kResiduals, 1> numeric = (r_plus - r_minus) / (2.0 * step);
-    EXPECT_LT((numeric - point_jacobian.col(j)).norm(), 1e-4) << "point column " << j;
+    EXPECT_LT((jacobian_weight * numeric - point_jacobian.col(j)).norm(), 1e-4)
+        << "point column " << j;
   }
 }
 
-TEST(ReprojectionError, MonocularJacobiansMatchFiniteDifferences) { check_bundle_jacobians<2>(); }
+TEST(ReprojectionError, MonocularJacobiansMatchFiniteDifferences) {
+  check_bundle_jacobians<2, ObservationRows::kPixel>(0.0);
+}
 
-TEST(ReprojectionError, RgbdJacobiansMatchFiniteDifferences) { check_bundle_jacobians<3>(); }
+TEST(ReprojectionError, RgbdJacobiansMatchFiniteDifferences) {
+  check_bundle_jacobians<3, ObservationRows::kPixel>(0.0);
+  check_bundle_jacobians<3, ObservationRows::kRightPadded>(0.0);
+}
+
+TEST(ReprojectionError, HuberWeightedJacobiansAreScaledDerivatives) {
+  // The test residuals (measurement 300 px everywhere) are far outside δ: the kernel is active.
+  check_bundle_jacobians<2, ObservationRows::kPixel>(std::sqrt(5.991));
+  check_bundle_jacobians<3, ObservationRows::kRightPadded>(std::sqrt(7.815));
+}
+
+TEST(ReprojectionError, HuberScalingGivesTheRobustCost) {
+  const double delta = 2.0;
+  EXPECT_EQ(huber_scaling(3.0, delta).residual, 1.0);  // inside: untouched
+  EXPECT_EQ(huber_scaling(3.0, delta).jacobian, 1.0);
+  const double s = 25.0;  // |r| = 5
+  const RobustScaling scaling = huber_scaling(s, delta);
+  EXPECT_NEAR(scaling.residual * scaling.residual * s, 2.0 * delta * 5.0 - delta * delta, 1e-12);
+  EXPECT_NEAR(scaling.jacobian * scaling.jacobian, delta / 5.0, 1e-12);
+  EXPECT_EQ(huber_scaling(s, 0.0).residual, 1.0);  // disabled
+}
 
 TEST(ReprojectionError, PointBehindCameraIsRejected) {
   const PinholeCamera camera = testing::test_camera();

@@ -57,8 +57,8 @@ std::vector<KeypointMatch> search_for_triangulation(const KeyFrame& first, const
   // Epipole of the first camera in the second image: matches next to it are ill-conditioned.
   const Eigen::Vector3d center1_in_2 = second.T_camera_world() * first.camera_center();
   const PinholeCamera& pinhole = second.camera().pinhole;
-  const Eigen::Vector2d epipole = center1_in_2.z() > 0.0 ? pinhole.project(center1_in_2)
-                                                         : Eigen::Vector2d(-1e9, -1e9);
+  const Eigen::Vector2d epipole =
+      center1_in_2.z() > 0.0 ? pinhole.project(center1_in_2) : Eigen::Vector2d(-1e9, -1e9);
 
   const std::vector<std::shared_ptr<MapPoint>> points1 = first.map_points();
   const std::vector<std::shared_ptr<MapPoint>> points2 = second.map_points();
@@ -83,7 +83,8 @@ std::vector<KeypointMatch> search_for_triangulation(const KeyFrame& first, const
     for (const int i2 : free2) {
       if (matched2[i2]) continue;
       const cv::KeyPoint& keypoint2 = second.keypoints()[i2];
-      const double distance_to_line = line.x() * keypoint2.pt.x + line.y() * keypoint2.pt.y + line.z();
+      const double distance_to_line =
+          line.x() * keypoint2.pt.x + line.y() * keypoint2.pt.y + line.z();
       if (distance_to_line * distance_to_line >= 3.84 * sigma2[keypoint2.octave] * line_norm2) {
         continue;
       }

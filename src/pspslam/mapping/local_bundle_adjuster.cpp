@@ -55,10 +55,10 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe) {
       }
       const int index = observation.keypoint_index;
       const cv::KeyPoint& keypoint = observer->keypoints()[index];
-      window.problem.observations.push_back(
-          {slot->second, p, Eigen::Vector2d(keypoint.pt.x, keypoint.pt.y),
-           static_cast<double>(observer->right_u(index)),
-           observer->pyramid().inv_sigma2[keypoint.octave]});
+      window.problem.observations.push_back({slot->second, p,
+                                             Eigen::Vector2d(keypoint.pt.x, keypoint.pt.y),
+                                             static_cast<double>(observer->right_u(index)),
+                                             observer->pyramid().inv_sigma2[keypoint.octave]});
       window.keypoint_index.push_back(index);
     }
   }
@@ -105,8 +105,7 @@ LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
     point->set_position(window.problem.points[p].position_world);
     point->update_normal_and_depth(keyframe->pyramid());
   }
-  report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 

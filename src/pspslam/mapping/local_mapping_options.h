@@ -21,7 +21,7 @@ struct LocalMappingOptions {
   double fusion_radius = 3.0;  // pixels at level 0, times the level scale
   // Recent map point culling.
   double min_found_ratio = 0.25;
-  int min_observations = 3;     // a depth observation counts twice
+  int min_observations = 3;       // a depth observation counts twice
   int culling_keyframe_span = 2;  // keyframes after creation before min_observations applies
   int probation_keyframes = 3;    // after this many keyframes a point is no longer "recent"
   // Redundant keyframe culling: a keyframe goes when more than this fraction of its close map

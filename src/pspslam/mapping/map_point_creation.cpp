@@ -12,9 +12,9 @@
 namespace pspslam {
 namespace {
 
-std::shared_ptr<MapPoint> make_point(Map& map, const Eigen::Vector3d& position,
-                                     const std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>&
-                                         observations) {
+std::shared_ptr<MapPoint> make_point(
+    Map& map, const Eigen::Vector3d& position,
+    const std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>& observations) {
   const auto& reference = observations.front().first;
   auto point = std::make_shared<MapPoint>(map.next_map_point_id(), position, reference);
   for (const auto& [keyframe, index] : observations) {
@@ -87,7 +87,8 @@ std::vector<std::shared_ptr<MapPoint>> create_points_from_depth(
   std::sort(by_depth.begin(), by_depth.end());
   std::vector<std::shared_ptr<MapPoint>> created;
   for (const auto& [depth, index] : by_depth) {
-    if (depth > options.close_depth && static_cast<int>(created.size()) >= options.min_depth_points) {
+    if (depth > options.close_depth &&
+        static_cast<int>(created.size()) >= options.min_depth_points) {
       break;
     }
     created.push_back(make_point(map, keyframe->unproject_world(index), {{keyframe, index}}));

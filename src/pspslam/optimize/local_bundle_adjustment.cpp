@@ -1,15 +1,12 @@
 #include "pspslam/optimize/local_bundle_adjustment.h"
 
 #include <ceres/iteration_callback.h>
-#include <ceres/loss_function.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -82,12 +79,11 @@ class BaStage {
             const std::vector<uint8_t>& use, bool robust, int max_iterations, double max_seconds,
             StopCallback& stop_callback) {
     ceres::Problem::Options problem_options;
-    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // manifold_ is ours
     ceres::Problem ceres_problem(problem_options);
 
-    ceres::HuberLoss huber_mono(options_.huber_delta_mono);
-    ceres::HuberLoss huber_stereo(options_.huber_delta_stereo);
+    const double huber_mono = robust ? options_.huber_delta_mono : 0.0;
+    const double huber_stereo = robust ? options_.huber_delta_stereo : 0.0;
     std::vector<uint8_t> pose_added(poses.size(), 0);
     std::vector<uint8_t> point_added(points.size(), 0);
     for (size_t i = 0; i < problem_.observations.size(); ++i) {
@@ -99,14 +95,17 @@ class BaStage {
       if (has_depth(observation)) {
         const Measurement<3> measured(observation.pixel.x(), observation.pixel.y(),
                                       observation.right_u);
-        auto cost = std::make_unique<BundleReprojectionCost<3>>(model_, measured, sqrt_information);
-        ceres_problem.AddResidualBlock(cost.release(), robust ? &huber_stereo : nullptr, pose,
-                                       point);
+        auto pixel_rows = std::make_unique<BundleReprojectionCost<3, ObservationRows::kPixel>>(
+            model_, measured, sqrt_information, huber_stereo);
+        auto right_rows =
+            std::make_unique<BundleReprojectionCost<3, ObservationRows::kRightPadded>>(
+                model_, measured, sqrt_information, huber_stereo);
+        ceres_problem.AddResidualBlock(pixel_rows.release(), nullptr, pose, point);
+        ceres_problem.AddResidualBlock(right_rows.release(), nullptr, pose, point);
       } else {
-        auto cost =
-            std::make_unique<BundleReprojectionCost<2>>(model_, observation.pixel, sqrt_information);
-        ceres_problem.AddResidualBlock(cost.release(), robust ? &huber_mono : nullptr, pose,
-                                       point);
+        auto cost = std::make_unique<BundleReprojectionCost<2, ObservationRows::kPixel>>(
+            model_, observation.pixel, sqrt_information, huber_mono);
+        ceres_problem.AddResidualBlock(cost.release(), nullptr, pose, point);
       }
       pose_added[observation.keyframe] = 1;
       point_added[observation.point] = 1;
@@ -134,9 +133,9 @@ class BaStage {
     if (num_points == 0) return 0;
 
     ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = free_keyframes <= options_.max_free_keyframes_for_dense_schur
-                                            ? ceres::DENSE_SCHUR
-                                            : ceres::SPARSE_SCHUR;
+    solver_options.linear_solver_type =
+        free_keyframes <= options_.max_free_keyframes_for_dense_schur ? ceres::DENSE_SCHUR
+                                                                      : ceres::SPARSE_SCHUR;
     solver_options.linear_solver_ordering = ordering;
     solver_options.max_num_iterations = max_iterations;
     solver_options.max_solver_time_in_seconds = std::max(max_seconds, 0.0);
@@ -147,7 +146,6 @@ class BaStage {
 
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &ceres_problem, &summary);
-    if (std::getenv("PSPSLAM_DIAG")) fprintf(stderr, "%s\n", summary.FullReport().c_str());
     return summary.num_successful_steps + summary.num_unsuccessful_steps;
   }
 
@@ -207,8 +205,8 @@ BaResult solve_bundle_adjustment(BaProblem& problem, const PinholeCamera& camera
 
   BaStage stage(problem, model, options);
   StopCallback stop_callback(options.should_stop);
-  result.iterations += stage.solve(poses, points, inlier, /*robust=*/true, options.robust_iterations,
-                                   seconds_left(), stop_callback);
+  result.iterations += stage.solve(poses, points, inlier, /*robust=*/true,
+                                   options.robust_iterations, seconds_left(), stop_callback);
   classify(inlier);
   if (!stop_callback.stopped() && seconds_left() > 0.0) {
     result.iterations += stage.solve(poses, points, inlier, /*robust=*/false,

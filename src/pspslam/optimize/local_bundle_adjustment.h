@@ -4,7 +4,8 @@
 // into a BaProblem, solves, and writes poses/points back and erases the outlier observations.
 //
 // Call pattern (local mapping):
-//   BaProblem problem;                    // keyframes: local (fixed = false) + border (fixed = true)
+//   BaProblem problem;                    // keyframes: local (fixed = false) + border (fixed =
+//   true)
 //   ... fill keyframes, points, observations (indices into the two vectors) ...
 //   BaOptions options;
 //   options.should_stop = [&] { return new_keyframe_waiting(); };   // aborts between iterations
@@ -72,7 +73,7 @@ struct BaResult {
   // ½ Σ χ² (no robust kernel) over the final inliers, before and after: comparable numbers.
   double initial_cost = 0.0;
   double final_cost = 0.0;
-  int iterations = 0;  // both stages together
+  int iterations = 0;          // both stages together
   bool stopped_early = false;  // should_stop fired or the time budget ran out
 };
 

@@ -13,8 +13,7 @@ using ConstVector3Map = Eigen::Map<const Eigen::Vector3d>;
 Eigen::Quaterniond so3_exp(const Eigen::Vector3d& omega) {
   const double angle = omega.norm();
   if (angle < 1e-12) {
-    return Eigen::Quaterniond(1.0, 0.5 * omega.x(), 0.5 * omega.y(), 0.5 * omega.z())
-        .normalized();
+    return Eigen::Quaterniond(1.0, 0.5 * omega.x(), 0.5 * omega.y(), 0.5 * omega.z()).normalized();
   }
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle));
 }

@@ -64,8 +64,7 @@ struct PreparedObservation {
 // manifold, building the problem each round) cost more than the residuals themselves. Here the
 // parameter block is Euclidean (δ, re-based every round) and the inner loop is ours.
 // Because Ceres applies a loss function to a whole block, the Huber kernel is applied inside, per
-// observation, the way g2o does it: the residual is scaled to carry ρ(s) (so the cost is the
-// robust cost) and the Jacobian is weighted by √ρ'(s) (iteratively reweighted least squares).
+// observation (huber_scaling).
 class FrameReprojectionCost final : public ceres::CostFunction {
  public:
   FrameReprojectionCost(const StereoProjection& model, std::vector<PreparedObservation> prepared,
@@ -98,12 +97,11 @@ class FrameReprojectionCost final : public ceres::CostFunction {
     for (const PreparedObservation& observation : prepared_) {
       const Eigen::Vector3d point_camera = rotation * observation.point_base + translation;
       double* jacobian_rows = jacobian != nullptr ? jacobian + row * 6 : nullptr;
-      const bool ok =
-          observation.has_depth
-              ? evaluate_one<3>(observation, point_camera, left_jacobian, residuals + row,
-                                jacobian_rows)
-              : evaluate_one<2>(observation, point_camera, left_jacobian, residuals + row,
-                                jacobian_rows);
+      const bool ok = observation.has_depth
+                          ? evaluate_one<3>(observation, point_camera, left_jacobian,
+                                            residuals + row, jacobian_rows)
+                          : evaluate_one<2>(observation, point_camera, left_jacobian,
+                                            residuals + row, jacobian_rows);
       if (!ok) return false;  // a point went behind the camera: Ceres rejects the step
       row += observation.has_depth ? 3 : 2;
     }
@@ -122,14 +120,9 @@ class FrameReprojectionCost final : public ceres::CostFunction {
                                        jacobian_out ? &d_residual_d_point : nullptr)) {
       return false;
     }
-    const double delta = kResiduals == 3 ? huber_delta_stereo_ : huber_delta_mono_;
-    const double squared_norm = residual.squaredNorm();
-    if (robust_ && squared_norm > delta * delta) {
-      // Huber: ρ(s) = 2δ√s − δ², ρ'(s) = δ/√s for s > δ².
-      const double norm = std::sqrt(squared_norm);
-      residual *= std::sqrt((2.0 * delta * norm - delta * delta) / squared_norm);
-      if (jacobian_out != nullptr) d_residual_d_point *= std::sqrt(delta / norm);
-    }
+    const double delta = !robust_ ? 0.0 : kResiduals == 3 ? huber_delta_stereo_ : huber_delta_mono_;
+    const RobustScaling scaling = huber_scaling(residual.squaredNorm(), delta);
+    residual *= scaling.residual;
     Eigen::Map<Eigen::Matrix<double, kResiduals, 1>> output(residual_out);
     output = residual;
     if (jacobian_out != nullptr) {
@@ -139,6 +132,7 @@ class FrameReprojectionCost final : public ceres::CostFunction {
           -point_camera.z(), 0.0, point_camera.x(),            //
           point_camera.y(), -point_camera.x(), 0.0;
       Eigen::Map<Eigen::Matrix<double, kResiduals, 6, Eigen::RowMajor>> jacobian(jacobian_out);
+      d_residual_d_point *= scaling.jacobian;
       jacobian.template leftCols<3>() = d_residual_d_point * (minus_skew * left_jacobian);
       jacobian.template rightCols<3>() = d_residual_d_point;
     }
@@ -153,8 +147,7 @@ class FrameReprojectionCost final : public ceres::CostFunction {
 };
 
 std::vector<PreparedObservation> prepare(const std::vector<PoseObservation>& observations,
-                                         const std::vector<uint8_t>& selected,
-                                         const Pose& base) {
+                                         const std::vector<uint8_t>& selected, const Pose& base) {
   std::vector<PreparedObservation> prepared;
   prepared.reserve(observations.size());
   for (size_t i = 0; i < observations.size(); ++i) {

@@ -24,8 +24,8 @@ namespace pspslam {
 struct PoseObservation {
   Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // undistorted keypoint
-  double right_u = -1.0;      // virtual right coordinate u − bf/z; < 0: no depth (2-dof residual)
-  double information = 1.0;   // 1 / σ² of the keypoint's pyramid level (σ² = scale²)
+  double right_u = -1.0;     // virtual right coordinate u − bf/z; < 0: no depth (2-dof residual)
+  double information = 1.0;  // 1 / σ² of the keypoint's pyramid level (σ² = scale²)
 };
 
 struct PoseOptimizationResult {

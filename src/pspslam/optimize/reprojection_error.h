@@ -30,8 +30,9 @@ using Measurement = Eigen::Matrix<double, kResiduals, 1>;
 // Whitened residual r = √information · (measurement − projection(p_c)) and, when requested,
 // ∂r/∂p_c. Returns false for points at or behind the camera, where the projection is undefined.
 template <int kResiduals>
-inline bool whitened_residual(const StereoProjection& model, const Measurement<kResiduals>& measured,
-                              double sqrt_information, const Eigen::Vector3d& point_camera,
+inline bool whitened_residual(const StereoProjection& model,
+                              const Measurement<kResiduals>& measured, double sqrt_information,
+                              const Eigen::Vector3d& point_camera,
                               Eigen::Matrix<double, kResiduals, 1>& residual,
                               Eigen::Matrix<double, kResiduals, 3>* d_residual_d_point) {
   static_assert(kResiduals == 2 || kResiduals == 3);
@@ -100,46 +101,85 @@ inline Eigen::Vector3d transform_point(const double* pose_parameters,
   return rotation * point_world + translation;
 }
 
+// Huber kernel applied inside a residual, g2o style, for costs that cannot use a Ceres loss
+// function on the whole block: the residual is scaled so its squared norm is ρ(s) (the cost is the
+// robust cost) and the Jacobian by √ρ'(s) (iteratively reweighted least squares).
+// ρ(s) = s for s ≤ δ², 2δ√s − δ² beyond; delta <= 0 disables the kernel.
+struct RobustScaling {
+  double residual = 1.0;
+  double jacobian = 1.0;
+};
+
+inline RobustScaling huber_scaling(double squared_norm, double delta) {
+  if (delta <= 0.0 || squared_norm <= delta * delta) return {};
+  const double norm = std::sqrt(squared_norm);
+  return {std::sqrt((2.0 * delta * norm - delta * delta) / squared_norm), std::sqrt(delta / norm)};
+}
+
+// Which rows of an observation one bundle-adjustment residual block carries. Every block has two
+// rows so that Ceres' Schur eliminator runs its compiled <2, 3, 6> specialisation: with mixed 2-
+// and 3-row blocks it falls back to the generic dynamic-size code, several times slower. An RGB-D
+// observation (u, v, u_r) is therefore two blocks, (u, v) and (u_r, 0); the padding row is zero in
+// value and Jacobian and so changes nothing.
+enum class ObservationRows { kPixel, kRightPadded };
+
 // Residual of a point (parameter block 2, world coordinates) seen by a keyframe (block 1, pose).
-template <int kResiduals>
-class BundleReprojectionCost final : public ceres::SizedCostFunction<kResiduals, 7, 3> {
+// kDof = 2: (u, v) only; kDof = 3: with depth, the robust kernel sees all three rows' χ².
+template <int kDof, ObservationRows kRows>
+class BundleReprojectionCost final : public ceres::SizedCostFunction<2, 7, 3> {
+  static_assert(kDof == 3 || kRows == ObservationRows::kPixel);
+
  public:
-  BundleReprojectionCost(const StereoProjection& model, const Measurement<kResiduals>& measured,
-                         double sqrt_information)
-      : model_(model), measured_(measured), sqrt_information_(sqrt_information) {}
+  BundleReprojectionCost(const StereoProjection& model, const Measurement<kDof>& measured,
+                         double sqrt_information, double huber_delta)
+      : model_(model),
+        measured_(measured),
+        sqrt_information_(sqrt_information),
+        huber_delta_(huber_delta) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const Eigen::Map<const Eigen::Vector3d> point_world(parameters[1]);
     const Eigen::Vector3d point_camera = transform_point(parameters[0], point_world);
-    Eigen::Map<Eigen::Matrix<double, kResiduals, 1>> residual(residuals);
-    Eigen::Matrix<double, kResiduals, 1> value;
     const bool want_jacobian =
         jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr);
-    Eigen::Matrix<double, kResiduals, 3> d_residual_d_point;
-    if (!whitened_residual<kResiduals>(model_, measured_, sqrt_information_, point_camera, value,
-                                       want_jacobian ? &d_residual_d_point : nullptr)) {
+    Eigen::Matrix<double, kDof, 1> residual;
+    Eigen::Matrix<double, kDof, 3> d_residual_d_point;
+    if (!whitened_residual<kDof>(model_, measured_, sqrt_information_, point_camera, residual,
+                                 want_jacobian ? &d_residual_d_point : nullptr)) {
       return false;
     }
-    residual = value;
+    const RobustScaling scaling = huber_scaling(residual.squaredNorm(), huber_delta_);
+    Eigen::Vector2d rows;
+    Eigen::Matrix<double, 2, 3> d_rows_d_point;
+    if constexpr (kRows == ObservationRows::kPixel) {
+      rows = residual.template head<2>();
+      if (want_jacobian) d_rows_d_point = d_residual_d_point.template topRows<2>();
+    } else {
+      rows << residual(2), 0.0;
+      if (want_jacobian) d_rows_d_point << d_residual_d_point.row(2), Eigen::RowVector3d::Zero();
+    }
+    Eigen::Map<Eigen::Vector2d> output(residuals);
+    output = scaling.residual * rows;
     if (!want_jacobian) return true;
+    d_rows_d_point *= scaling.jacobian;
     if (jacobians[0] != nullptr) {
-      write_pose_jacobian<kResiduals>(d_residual_d_point, point_camera, jacobians[0]);
+      write_pose_jacobian<2>(d_rows_d_point, point_camera, jacobians[0]);
     }
     if (jacobians[1] != nullptr) {
       // ∂p_c/∂p_w = R.
       const Eigen::Map<const Eigen::Quaterniond> rotation(parameters[0]);
-      Eigen::Map<Eigen::Matrix<double, kResiduals, 3, Eigen::RowMajor>> point_jacobian(
-          jacobians[1]);
-      point_jacobian = d_residual_d_point * rotation.toRotationMatrix();
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> point_jacobian(jacobians[1]);
+      point_jacobian = d_rows_d_point * rotation.toRotationMatrix();
     }
     return true;
   }
 
  private:
   StereoProjection model_;
-  Measurement<kResiduals> measured_;
+  Measurement<kDof> measured_;
   double sqrt_information_;
+  double huber_delta_;
 };
 
 }  // namespace pspslam

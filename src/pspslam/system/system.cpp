@@ -79,6 +79,11 @@ class System::MappingConnection final : public KeyFrameSink {
     stats.max_queued_keyframes = max_queue_;
     stats.processed_keyframes = processed_;
     stats.local_ba_ms_total = ba_ms_total_;
+    stats.keyframes_culled = last_.keyframes_culled;
+    stats.points_culled = last_.points_culled;
+    stats.points_triangulated = last_.points_triangulated;
+    stats.points_fused = last_.points_fused;
+    stats.ba_outliers_removed = last_.ba_outliers_removed;
   }
 
  private:
@@ -94,6 +99,7 @@ class System::MappingConnection final : public KeyFrameSink {
       bundle_adjustments_seen_ = stats.bundle_adjustments;
     }
     processed_ = stats.keyframes_processed;
+    last_ = stats;
   }
 
   std::unique_ptr<LocalMapping> mapping_;
@@ -102,6 +108,7 @@ class System::MappingConnection final : public KeyFrameSink {
   size_t processed_ = 0;
   std::uint64_t bundle_adjustments_seen_ = 0;
   double ba_ms_total_ = 0.0;
+  LocalMappingStats last_;
 };
 
 System::System(const SystemConfig& config, SystemOptions options)

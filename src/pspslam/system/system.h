@@ -42,6 +42,11 @@ struct MappingStats {
   size_t max_queued_keyframes = 0;   // over the run: growth means mapping cannot keep up
   size_t processed_keyframes = 0;
   double local_ba_ms_total = 0.0;    // wall time spent in local BA so far
+  size_t keyframes_culled = 0;
+  size_t points_culled = 0;
+  size_t points_triangulated = 0;
+  size_t points_fused = 0;
+  size_t ba_outliers_removed = 0;
 };
 
 // The SLAM system: owns the map, the ORB extractor, the tracker (runs on the caller's thread

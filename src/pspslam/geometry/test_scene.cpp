@@ -1,4 +1,4 @@
-#include "pspslam/geometry/synthetic_scene.h"
+#include "pspslam/geometry/test_scene.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -33,7 +33,7 @@ bool intersect_box(const Eigen::Vector3d& origin, const Eigen::Vector3d& directi
 
 }  // namespace
 
-SyntheticScene::SyntheticScene(SyntheticSceneParams params) : params_(params) {
+GeometryTestScene::GeometryTestScene(GeometryTestSceneParams params) : params_(params) {
   std::mt19937_64 rng(params_.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   // World: x right, y down (floor at y = 1.2), z forward; the camera starts near the origin.
@@ -57,13 +57,13 @@ SyntheticScene::SyntheticScene(SyntheticSceneParams params) : params_(params) {
   }
 }
 
-Eigen::Vector3d SyntheticScene::box_center(const Box& box, double time) const {
+Eigen::Vector3d GeometryTestScene::box_center(const Box& box, double time) const {
   Eigen::Vector3d c = box.center;
   if (box.amplitude > 0.0) c.x() += box.amplitude * std::sin(box.omega * time + box.phase);
   return c;
 }
 
-Pose SyntheticScene::camera_pose(int frame) const {
+Pose GeometryTestScene::camera_pose(int frame) const {
   const double t = frame / params_.fps;
   Pose T = Pose::Identity();
   // Hand-held-like motion: slow translation and a few degrees of yaw/pitch.
@@ -75,7 +75,7 @@ Pose SyntheticScene::camera_pose(int frame) const {
   return T;
 }
 
-void SyntheticScene::render(int frame, cv::Mat& depth, cv::Mat& labels) const {
+void GeometryTestScene::render(int frame, cv::Mat& depth, cv::Mat& labels) const {
   const PinholeCamera& cam = params_.camera;
   const double time = frame / params_.fps;
   const Pose T_world_camera = camera_pose(frame);

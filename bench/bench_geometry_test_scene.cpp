@@ -1,5 +1,5 @@
 // Accuracy / cost of the geometry module (paper III.C) on the analytic synthetic scene with
-// ground-truth labels (pspslam::SyntheticScene). Plain table output; see docs/geometry.md.
+// ground-truth labels (pspslam::GeometryTestScene). Plain table output; see docs/geometry.md.
 //
 //   bench_geometry_synthetic [--frames N] [--seeds S] [--width W] [--sweep NAME] [--key value ...]
 //
@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/geometry/synthetic_scene.h"
+#include "pspslam/geometry/test_scene.h"
 
 namespace {
 
@@ -117,10 +117,10 @@ Dataset render_dataset(const Options& o) {
   data.camera.cy = data.camera.height / 2.0 - 0.5;
   long dynamic = 0, total = 0;
   for (int seed = 1; seed <= o.seeds; ++seed) {
-    SyntheticSceneParams sp;
+    GeometryTestSceneParams sp;
     sp.camera = data.camera;
     sp.seed = seed;
-    const SyntheticScene scene(sp);
+    const GeometryTestScene scene(sp);
     std::mt19937_64 rng(seed * 77);
     for (int f = 0; f < o.frames; ++f) {
       const int current = 50 + 7 * f;

@@ -11,11 +11,11 @@
 namespace pspslam {
 
 // A small analytic RGB-D scene with ground-truth dynamic labels, used by the geometry module's
-// tests and its parameter sweep (bench_geometry): a room with static furniture, people walking
+// tests and its parameter sweeps (bench_geometry_test_scene): a room with static furniture, people walking
 // (label 15) and a box one person carries (label 100), seen by a moving camera. Depth follows
 // a Kinect-like noise model and is quantised to 1/5000 m, as in TUM/Bonn files. Labels use the
 // same convention as `pspslam synth` masks: 0 static, 15 person, 100 carried object.
-struct SyntheticSceneParams {
+struct GeometryTestSceneParams {
   PinholeCamera camera;
   int people = 2;
   bool carried_object = true;
@@ -25,15 +25,15 @@ struct SyntheticSceneParams {
   std::uint64_t seed = 1;
 };
 
-class SyntheticScene {
+class GeometryTestScene {
  public:
-  explicit SyntheticScene(SyntheticSceneParams params);
+  explicit GeometryTestScene(GeometryTestSceneParams params);
 
   Pose camera_pose(int frame) const;  // T_world_camera
   // depth: CV_32FC1 metres (noisy, quantised); labels: CV_8UC1.
   void render(int frame, cv::Mat& depth, cv::Mat& labels) const;
 
-  const SyntheticSceneParams& params() const { return params_; }
+  const GeometryTestSceneParams& params() const { return params_; }
 
  private:
   struct Box {
@@ -47,7 +47,7 @@ class SyntheticScene {
   };
   Eigen::Vector3d box_center(const Box& box, double time) const;
 
-  SyntheticSceneParams params_;
+  GeometryTestSceneParams params_;
   std::vector<Box> boxes_;
 };
 

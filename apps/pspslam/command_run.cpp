@@ -8,12 +8,12 @@
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state
 #include <algorithm>
 #include <chrono>
-#include <utility>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.h"
@@ -63,7 +63,8 @@ int run_command(const std::vector<std::string>& args) {
                     "track only: keyframes enter the map but are never refined (debugging)");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
-  if (max_frames_flag < 0) throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
+  if (max_frames_flag < 0)
+    throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
 
   const std::optional<std::filesystem::path> config =
       parser.has("config") ? std::optional<std::filesystem::path>(parser.get("config"))
@@ -153,8 +154,8 @@ int run_command(const std::vector<std::string>& args) {
                 "%.0f ms total\n",
                 processed, processed - lost_count, lost_count,
                 seconds > 0 ? processed / seconds : 0.0, seconds, median(extraction_ms),
-                median(tracking_ms), median(tracking_cpu_ms), mapping.keyframes_in_map, mapping.map_points,
-                mapping.max_queued_keyframes, mapping.local_ba_ms_total);
+                median(tracking_ms), median(tracking_cpu_ms), mapping.keyframes_in_map,
+                mapping.map_points, mapping.max_queued_keyframes, mapping.local_ba_ms_total);
   std::cout << line;
   std::snprintf(line, sizeof(line),
                 "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "

@@ -18,8 +18,8 @@ class CovisibilityTest : public ::testing::Test {
     for (int i = 0; i < 60; ++i) keypoints.emplace_back(cv::Point2f(10.0f * i, 100.0f), 31.0f);
     cv::Mat descriptors(60, 32, CV_8U);
     cv::randu(descriptors, 0, 256);
-    Frame frame(frame_id, static_cast<double>(frame_id), keypoints, descriptors, cv::Mat(),
-                camera_, pyramid_);
+    Frame frame(frame_id, static_cast<double>(frame_id), keypoints, descriptors, cv::Mat(), camera_,
+                pyramid_);
     frame.set_pose(Pose::Identity());
     auto keyframe = std::make_shared<KeyFrame>(map_.next_keyframe_id(), frame);
     map_.add_keyframe(keyframe);
@@ -32,8 +32,8 @@ class CovisibilityTest : public ::testing::Test {
                                                int count) {
     std::vector<std::shared_ptr<MapPoint>> points;
     for (int k = 0; k < count; ++k) {
-      auto point = std::make_shared<MapPoint>(map_.next_map_point_id(),
-                                              Eigen::Vector3d(k, 0.0, 3.0), a);
+      auto point =
+          std::make_shared<MapPoint>(map_.next_map_point_id(), Eigen::Vector3d(k, 0.0, 3.0), a);
       point->add_observation(a, a_first + k);
       point->add_observation(b, b_first + k);
       a->add_map_point(a_first + k, point);

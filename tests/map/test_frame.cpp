@@ -58,7 +58,8 @@ TEST(Frame, UndistortionAndBackProjectionRoundTrip) {
     const Eigen::Vector3d truth(kept[i].x, kept[i].y, kept[i].z);
     const Eigen::Vector2d ideal = camera->pinhole.project(truth);
     const cv::Point2f& undistorted = frame.keypoints()[i].pt;
-    max_pixel_error = std::max(max_pixel_error, (ideal - Eigen::Vector2d(undistorted.x, undistorted.y)).norm());
+    max_pixel_error =
+        std::max(max_pixel_error, (ideal - Eigen::Vector2d(undistorted.x, undistorted.y)).norm());
     ASSERT_NEAR(frame.depth(i), truth.z(), 1e-6);
     EXPECT_NEAR(frame.right_u(i), undistorted.x - camera->bf / truth.z(), 1e-3);
     max_point_error = std::max(max_point_error, (frame.unproject_world(i) - truth).norm());

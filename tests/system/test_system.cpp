@@ -25,11 +25,14 @@ TEST(System, TracksAShortStaticSyntheticSequenceWithinOneCentimetre) {
   SynthFrame frame;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
     scene.render(i, frame, 1);
-    const FrameReport report = system.track(scene.timestamp(i), [&] {
-      cv::Mat gray;
-      cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-      return gray;
-    }(), frame.depth_sensor);
+    const FrameReport report = system.track(
+        scene.timestamp(i),
+        [&] {
+          cv::Mat gray;
+          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+          return gray;
+        }(),
+        frame.depth_sensor);
     ASSERT_TRUE(report.tracking.T_world_camera.has_value()) << "frame " << i << " lost";
     estimate.push_back({scene.timestamp(i), *report.tracking.T_world_camera});
   }

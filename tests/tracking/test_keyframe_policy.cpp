@@ -36,8 +36,8 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
 
 TEST(KeyFramePolicy, KeyFrameWhenCloseStructureIsUntracked) {
   KeyFrameEvidence e = steady_tracking();
-  e.tracked_close_points = 90;   // < 100 tracked close points
-  e.untracked_close_points = 80; // > 70 untracked ones
+  e.tracked_close_points = 90;    // < 100 tracked close points
+  e.untracked_close_points = 80;  // > 70 untracked ones
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
   e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);

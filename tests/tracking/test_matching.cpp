@@ -38,7 +38,8 @@ class ProjectionSearchTest : public ::testing::Test {
     for (int i = 0; i < kPoints; ++i) {
       const Eigen::Vector2d pixel = camera_->pinhole.project(positions_[i]);
       keypoints.emplace_back(cv::Point2f(pixel.x(), pixel.y()), 31.0f, 0.0f);
-      depth.at<float>(cvRound(pixel.y()), cvRound(pixel.x())) = static_cast<float>(positions_[i].z());
+      depth.at<float>(cvRound(pixel.y()), cvRound(pixel.x())) =
+          static_cast<float>(positions_[i].z());
       std::memcpy(descriptors.ptr(i), descriptors_[i].data(), 32);
     }
     Frame first(0, 0.0, keypoints, descriptors, depth, camera_, pyramid_);
@@ -117,8 +118,8 @@ TEST_F(ProjectionSearchTest, FindsTheRightMatchesWithKnownPose) {
     ProjectedPoint p;
     if (project_map_point(point, frame, p)) projected.push_back(p);
   }
-  const int visible = static_cast<int>(std::count_if(truth_.begin(), truth_.end(),
-                                                     [](int t) { return t >= 0; }));
+  const int visible =
+      static_cast<int>(std::count_if(truth_.begin(), truth_.end(), [](int t) { return t >= 0; }));
   EXPECT_EQ(static_cast<int>(projected.size()), visible);
   const int matches = search_by_projection(frame, projected, 1.0);
   int correct = 0;
@@ -145,8 +146,8 @@ TEST_F(ProjectionSearchTest, BruteForceAgainstKeyFrameNeedsNoPose) {
       ++correct;
     }
   }
-  const int visible = static_cast<int>(std::count_if(truth_.begin(), truth_.end(),
-                                                     [](int t) { return t >= 0; }));
+  const int visible =
+      static_cast<int>(std::count_if(truth_.begin(), truth_.end(), [](int t) { return t >= 0; }));
   EXPECT_EQ(correct, matches);
   EXPECT_GE(correct, visible * 95 / 100);
 }

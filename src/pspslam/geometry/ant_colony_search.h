@@ -20,7 +20,7 @@ enum class SearchStrategy {
 struct AntColonyParams {
   SearchStrategy strategy = SearchStrategy::ant_colony;
   float search_radius_px = 12.0f;  // R: points within R of a path node K_i are tested
-  float band_width_px = 20.0f;     // dZ: band around a community's convex hull tested per round
+  float band_width_px = 40.0f;     // dZ: band around a community's convex hull tested per round
   float node_spacing_px = 16.0f;   // s: distance between consecutive nodes along a lane
   float lane_spacing_px = 48.0f;   // distance between the boustrophedon lanes of the path L
   int max_band_rounds = 256;       // safety bound; a round that finds nothing ends growth anyway

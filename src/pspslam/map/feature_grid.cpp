@@ -34,14 +34,15 @@ FeatureGrid::FeatureGrid(const std::vector<cv::KeyPoint>& keypoints, double min_
 }
 
 void FeatureGrid::query(const std::vector<cv::KeyPoint>& keypoints, double x, double y,
-                        double radius, int min_level, int max_level,
-                        std::vector<int>& out) const {
+                        double radius, int min_level, int max_level, std::vector<int>& out) const {
   out.clear();
   if (cell_start_.empty()) return;
-  const int min_col = std::max(0, static_cast<int>(std::floor((x - radius - min_x_) * inv_cell_width_)));
+  const int min_col =
+      std::max(0, static_cast<int>(std::floor((x - radius - min_x_) * inv_cell_width_)));
   const int max_col =
       std::min(kCols - 1, static_cast<int>(std::ceil((x + radius - min_x_) * inv_cell_width_)));
-  const int min_row = std::max(0, static_cast<int>(std::floor((y - radius - min_y_) * inv_cell_height_)));
+  const int min_row =
+      std::max(0, static_cast<int>(std::floor((y - radius - min_y_) * inv_cell_height_)));
   const int max_row =
       std::min(kRows - 1, static_cast<int>(std::ceil((y + radius - min_y_) * inv_cell_height_)));
   if (min_col > max_col || min_row > max_row) return;

@@ -16,8 +16,8 @@ class FeatureGrid {
 
   FeatureGrid() = default;
   // Keypoints outside [min_x,max_x) x [min_y,max_y) are left out of the grid.
-  FeatureGrid(const std::vector<cv::KeyPoint>& keypoints, double min_x, double max_x,
-              double min_y, double max_y);
+  FeatureGrid(const std::vector<cv::KeyPoint>& keypoints, double min_x, double max_x, double min_y,
+              double max_y);
 
   // Appends to `out` (cleared first) the indices of keypoints within a square of half-size
   // `radius` around (x, y) whose octave is in [min_level, max_level] (max_level < 0: any).

@@ -24,8 +24,8 @@ class Frame {
   // read there (the depth image is registered to the distorted colour image), then the
   // keypoints are undistorted once. `descriptors`: N x 32 CV_8U (shared, not copied).
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
-        cv::Mat descriptors, const cv::Mat& depth_metres,
-        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid);
+        cv::Mat descriptors, const cv::Mat& depth_metres, std::shared_ptr<const RgbdCamera> camera,
+        std::shared_ptr<const ScalePyramid> pyramid);
 
   std::uint64_t id() const { return id_; }
   Timestamp timestamp() const { return timestamp_; }

@@ -31,8 +31,8 @@ class Map {
   void erase_map_point(const std::shared_ptr<MapPoint>& point);
 
   std::shared_ptr<KeyFrame> keyframe(std::uint64_t id) const;  // nullptr if erased
-  std::vector<std::shared_ptr<KeyFrame>> keyframes() const;     // ordered by id
-  std::vector<std::shared_ptr<MapPoint>> map_points() const;    // ordered by id
+  std::vector<std::shared_ptr<KeyFrame>> keyframes() const;    // ordered by id
+  std::vector<std::shared_ptr<MapPoint>> map_points() const;   // ordered by id
   size_t num_keyframes() const;
   size_t num_map_points() const;
   std::uint64_t max_keyframe_id() const;

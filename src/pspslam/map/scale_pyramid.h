@@ -13,10 +13,10 @@ struct ScalePyramid {
   int levels = 1;
   double scale_factor = 1.2;
   double log_scale_factor = 0.0;
-  std::vector<double> scale;            // scale_factor^level
-  std::vector<double> inv_scale;        // 1 / scale
-  std::vector<double> sigma2;           // scale^2: keypoint position variance per level
-  std::vector<double> inv_sigma2;       // information of one observation at this level
+  std::vector<double> scale;       // scale_factor^level
+  std::vector<double> inv_scale;   // 1 / scale
+  std::vector<double> sigma2;      // scale^2: keypoint position variance per level
+  std::vector<double> inv_sigma2;  // information of one observation at this level
 
   static ScalePyramid from_config(const OrbConfig& orb);
 

@@ -75,14 +75,16 @@ void LocalMapping::run(const std::stop_token& stop) {
     std::shared_ptr<KeyFrame> keyframe;
     {
       std::unique_lock lock(mutex_);
+      // Wake for a pause to acknowledge, or for work while not paused (or for shutdown).
+      wake_.wait(lock, stop, [this] {
+        return (stop_requested_ && !stopped_) || (!stop_requested_ && !queue_.empty());
+      });
+      if (stop.stop_requested()) break;
       if (stop_requested_) {
         stopped_ = true;
         idle_.notify_all();
+        continue;
       }
-      // Sleep until there is work and no pause is requested (or shutdown).
-      wake_.wait(lock, stop, [this] { return !stop_requested_ && !queue_.empty(); });
-      if (stop.stop_requested()) break;
-      stopped_ = false;
       keyframe = std::move(queue_.front());
       queue_.pop_front();
       busy_ = true;

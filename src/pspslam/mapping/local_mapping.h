@@ -3,8 +3,8 @@
 // Local mapping thread (ORB-SLAM2 LocalMapping): owns its worker thread and keyframe queue.
 //
 // Expected call pattern (tracking / System):
-//   auto mapping = std::make_unique<LocalMapping>(map, options);  // thread starts here
-//   // options.close_depth = config.camera.depth_threshold;
+//   auto mapping = std::make_unique<LocalMapping>(map, config);   // thread starts here
+//   // or LocalMapping(map, LocalMappingOptions{...}) to tune thresholds
 //   // tracking, when it decides on a new keyframe:
 //   if (mapping->accepts_keyframes() || mapping->queue_size() < 3) {
 //     mapping->insert_keyframe(keyframe);   // also interrupts a running local BA
@@ -30,6 +30,7 @@
 #include <mutex>
 #include <stop_token>
 #include <thread>
+#include <utility>
 
 #include "pspslam/mapping/local_mapper.h"
 #include "pspslam/mapping/local_mapping_options.h"
@@ -42,6 +43,8 @@ class Map;
 class LocalMapping {
  public:
   explicit LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options = {});
+  LocalMapping(std::shared_ptr<Map> map, const SystemConfig& config)
+      : LocalMapping(std::move(map), LocalMappingOptions::from_config(config)) {}
   ~LocalMapping();  // stops the worker (interrupting a BA) and joins it
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;

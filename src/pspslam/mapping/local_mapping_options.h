@@ -1,5 +1,6 @@
 #pragma once
 
+#include "pspslam/config/config.h"
 #include "pspslam/optimize/local_bundle_adjustment.h"
 
 namespace pspslam {
@@ -30,6 +31,13 @@ struct LocalMappingOptions {
   int redundant_observers = 3;
   bool cull_keyframes = true;
   BaOptions bundle_adjustment;
+
+  // Defaults, with the sensor's close-depth threshold from the config.
+  static LocalMappingOptions from_config(const SystemConfig& config) {
+    LocalMappingOptions options;
+    options.close_depth = config.camera.depth_threshold;
+    return options;
+  }
 };
 
 }  // namespace pspslam

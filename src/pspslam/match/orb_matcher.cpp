@@ -98,8 +98,7 @@ int search_by_projection(Frame& frame, const std::vector<ProjectedPoint>& projec
   for (const ProjectedPoint& p : projected) {
     if (p.point->is_bad()) continue;
     const int level = p.predicted_level;
-    const double radius =
-        radius_by_viewing_cos(p.view_cos) * radius_scale * pyramid.scale[level];
+    const double radius = radius_by_viewing_cos(p.view_cos) * radius_scale * pyramid.scale[level];
     frame.features_in_area(p.u, p.v, radius, level - 1, level, candidates);
     if (candidates.empty()) continue;
     const OrbDescriptor descriptor = p.point->descriptor();

@@ -14,10 +14,10 @@ class MapPoint;
 
 // ORB-SLAM2's matching thresholds on the 256-bit Hamming distance.
 struct MatcherOptions {
-  int max_distance_strict = 50;  // matches that seed a pose (previous frame, keyframe)
-  int max_distance_loose = 100;  // projection search of an already well-predicted point
-  double nn_ratio = 0.8;         // best / second best (Lowe's ratio test)
-  bool check_orientation = true; // rotation-consistency histogram
+  int max_distance_strict = 50;   // matches that seed a pose (previous frame, keyframe)
+  int max_distance_loose = 100;   // projection search of an already well-predicted point
+  double nn_ratio = 0.8;          // best / second best (Lowe's ratio test)
+  bool check_orientation = true;  // rotation-consistency histogram
 };
 
 // A map point predicted in a frame (computed by project_map_point): where to search and at

@@ -51,6 +51,8 @@ struct BaProblem {
 
 struct BaOptions {
   // Stage 1 (Huber) and stage 2 (plain least squares on the stage-1 inliers), as in ORB-SLAM2.
+  // The kernel acts on each observation's 2- or 3-dof χ², applied inside the residuals (IRLS
+  // weighting as in g2o) because an RGB-D observation spans two Ceres residual blocks.
   int robust_iterations = 5;
   int refine_iterations = 10;
   double huber_delta_mono = std::sqrt(5.991);

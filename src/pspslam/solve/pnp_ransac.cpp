@@ -23,10 +23,10 @@ PnpRansacResult solve_pnp_ransac(const PinholeCamera& camera,
   cv::Mat tvec;
   std::vector<int> inliers;
   // Keypoints are already undistorted: no distortion coefficients here.
-  const bool ok = cv::solvePnPRansac(object, image, camera.K(), cv::noArray(), rvec, tvec, false,
-                                     options.iterations,
-                                     static_cast<float>(options.max_reprojection_error),
-                                     options.confidence, inliers, cv::SOLVEPNP_EPNP);
+  const bool ok =
+      cv::solvePnPRansac(object, image, camera.K(), cv::noArray(), rvec, tvec, false,
+                         options.iterations, static_cast<float>(options.max_reprojection_error),
+                         options.confidence, inliers, cv::SOLVEPNP_EPNP);
   if (!ok || static_cast<int>(inliers.size()) < options.min_inliers) return result;
   cv::Mat rotation;
   cv::Rodrigues(rvec, rotation);

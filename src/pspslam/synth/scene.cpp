@@ -317,16 +317,34 @@ BoxSurface SyntheticScene::Impl::make_box(const Eigen::Vector3d& half, bool insi
     cv::Mat image =
         synth::make_texture_image(face_recipe, width_m, height_m, texels_per_metre, face_seed);
     if (static_pose) {
+      // Lighting varies slowly: evaluate it every kLightStep texels and interpolate, which
+      // keeps scene construction (paid by every test that renders frames) short.
+      constexpr int kLightStep = 8;
       const Eigen::Vector3d normal = static_pose->linear() * face_normal(face, inside);
       const int u_axis = (axis + 1) % 3, v_axis = (axis + 2) % 3;
+      const int grid_w = image.cols / kLightStep + 2, grid_h = image.rows / kLightStep + 2;
+      cv::Mat coarse(grid_h, grid_w, CV_32F);
       Eigen::Vector3d local;
       local[axis] = (face % 2 ? 1.0 : -1.0) * half[axis];
+      for (int j = 0; j < grid_h; ++j) {
+        local[v_axis] = (j * kLightStep + 0.5) / texels_per_metre - half[v_axis];
+        for (int i = 0; i < grid_w; ++i) {
+          local[u_axis] = (i * kLightStep + 0.5) / texels_per_metre - half[u_axis];
+          coarse.at<float>(j, i) = light_at(*static_pose * local, normal);
+        }
+      }
       for (int j = 0; j < image.rows; ++j) {
         auto* row = image.ptr<cv::Vec3b>(j);
-        local[v_axis] = (j + 0.5) / texels_per_metre - half[v_axis];
+        const int j0 = j / kLightStep;
+        const float fj = static_cast<float>(j % kLightStep) / kLightStep;
+        const float* top = coarse.ptr<float>(j0);
+        const float* bottom = coarse.ptr<float>(j0 + 1);
         for (int i = 0; i < image.cols; ++i) {
-          local[u_axis] = (i + 0.5) / texels_per_metre - half[u_axis];
-          const float shade = light_at(*static_pose * local, normal);
+          const int i0 = i / kLightStep;
+          const float fi = static_cast<float>(i % kLightStep) / kLightStep;
+          const float upper = top[i0] + (top[i0 + 1] - top[i0]) * fi;
+          const float lower = bottom[i0] + (bottom[i0 + 1] - bottom[i0]) * fi;
+          const float shade = upper + (lower - upper) * fj;
           for (int c = 0; c < 3; ++c) row[i][c] = cv::saturate_cast<uchar>(row[i][c] * shade);
         }
       }

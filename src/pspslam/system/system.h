@@ -38,10 +38,10 @@ struct FrameReport {
 struct MappingStats {
   size_t keyframes_in_map = 0;
   size_t map_points = 0;
-  size_t queued_keyframes = 0;       // waiting for local mapping now
-  size_t max_queued_keyframes = 0;   // over the run: growth means mapping cannot keep up
+  size_t queued_keyframes = 0;      // waiting for local mapping now
+  size_t max_queued_keyframes = 0;  // over the run: growth means mapping cannot keep up
   size_t processed_keyframes = 0;
-  double local_ba_ms_total = 0.0;    // wall time spent in local BA so far
+  double local_ba_ms_total = 0.0;  // wall time spent in local BA so far
   size_t keyframes_culled = 0;
   size_t points_culled = 0;
   size_t points_triangulated = 0;

@@ -9,8 +9,8 @@ struct KeyFramePolicyOptions {
   int min_frames_between = 0;   // frames since the last keyframe before an idle mapper may get one
   int max_frames_between = 30;  // frames after which a keyframe is due (camera fps)
   int max_queued_keyframes = 3;
-  int close_tracked_limit = 100;    // fewer tracked close points than this ...
-  int close_untracked_min = 70;     // ... and more untracked close ones: need a keyframe
+  int close_tracked_limit = 100;  // fewer tracked close points than this ...
+  int close_untracked_min = 70;   // ... and more untracked close ones: need a keyframe
 };
 
 struct KeyFrameEvidence {
@@ -18,10 +18,10 @@ struct KeyFrameEvidence {
   std::uint64_t last_keyframe_frame_id = 0;
   std::uint64_t last_relocalisation_frame_id = 0;
   int keyframes_in_map = 0;
-  int tracked_inliers = 0;            // matched map points after local map tracking
-  int reference_tracked_points = 0;   // points of the reference keyframe with enough observations
-  int tracked_close_points = 0;       // depth in (0, depth_threshold) and matched
-  int untracked_close_points = 0;     // depth in (0, depth_threshold) and unmatched
+  int tracked_inliers = 0;           // matched map points after local map tracking
+  int reference_tracked_points = 0;  // points of the reference keyframe with enough observations
+  int tracked_close_points = 0;      // depth in (0, depth_threshold) and matched
+  int untracked_close_points = 0;    // depth in (0, depth_threshold) and unmatched
   bool mapper_idle = true;
   int mapper_queue = 0;
 };

@@ -10,6 +10,18 @@
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
+namespace {
+
+// Re-projects the rotation onto SO(3). The constant-velocity prediction multiplies a pose by
+// the inverse of another (Isometry inverse = transpose): rounding errors in the rotation grow
+// by a factor ~2 per frame through that loop unless they are removed.
+Pose orthonormalized(const Pose& pose) {
+  Pose out = pose;
+  out.linear() = Eigen::Quaterniond(pose.rotation()).normalized().toRotationMatrix();
+  return out;
+}
+
+}  // namespace
 
 const char* to_string(TrackingState state) {
   switch (state) {
@@ -70,8 +82,7 @@ TrackResult Tracker::track(Frame frame) {
       const bool recovering = state_ == TrackingState::kLost;
       ok = track_reference_keyframe(frame, recovering);
       if (ok) {
-        result.method =
-            recovering ? TrackingMethod::kRecovery : TrackingMethod::kReferenceKeyFrame;
+        result.method = recovering ? TrackingMethod::kRecovery : TrackingMethod::kReferenceKeyFrame;
         if (recovering) last_recovery_frame_id_ = frame.id();
       }
     }
@@ -94,7 +105,7 @@ TrackResult Tracker::track(Frame frame) {
   if (state_ == TrackingState::kOk && frame.has_pose()) {
     result.T_world_camera = frame.T_world_camera();
     if (last_tracked_pose_ && last_frame_ && last_frame_->has_pose()) {
-      velocity_ = frame.T_camera_world() * last_frame_->T_camera_world().inverse();
+      velocity_ = orthonormalized(frame.T_camera_world() * last_frame_->T_camera_world().inverse());
     } else {
       velocity_.reset();
     }
@@ -169,14 +180,13 @@ int Tracker::optimize_frame_pose(Frame& frame) {
     if (!point) continue;
     const cv::KeyPoint& kp = frame.keypoints()[i];
     observations_.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                             static_cast<double>(frame.right_u(i)),
-                             pyramid.inv_sigma2[kp.octave]});
+                             static_cast<double>(frame.right_u(i)), pyramid.inv_sigma2[kp.octave]});
     observation_keypoint_.push_back(i);
   }
   const PoseOptimizationResult optimized =
       optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
                     observations_, options_.pose_optimizer);
-  frame.set_pose(optimized.T_camera_world);
+  frame.set_pose(orthonormalized(optimized.T_camera_world));
   for (size_t k = 0; k < observation_keypoint_.size(); ++k) {
     frame.outlier[observation_keypoint_[k]] = optimized.inlier[k] ? 0 : 1;
   }
@@ -184,10 +194,10 @@ int Tracker::optimize_frame_pose(Frame& frame) {
 }
 
 bool Tracker::track_with_motion_model(Frame& frame) {
-  frame.set_pose(*velocity_ * last_frame_->T_camera_world());
+  frame.set_pose(orthonormalized(*velocity_ * last_frame_->T_camera_world()));
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-  int matches = search_previous_frame(frame, *last_frame_, options_.motion_search_radius,
-                                      options_.matcher);
+  int matches =
+      search_previous_frame(frame, *last_frame_, options_.motion_search_radius, options_.matcher);
   if (matches < options_.min_motion_matches) {
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
     matches = search_previous_frame(frame, *last_frame_, 2.0 * options_.motion_search_radius,

@@ -19,12 +19,12 @@ class KeyFrameSink;
 class Map;
 
 struct TrackerOptions {
-  int min_initial_depth_points = 500;     // keypoints with depth needed to start the map
-  double motion_search_radius = 7.0;      // pixels at level 0 (ORB-SLAM2 RGB-D)
-  int min_motion_matches = 20;            // below: search again with twice the radius
-  int min_pose_inliers = 10;              // motion model / reference keyframe success
+  int min_initial_depth_points = 500;  // keypoints with depth needed to start the map
+  double motion_search_radius = 7.0;   // pixels at level 0 (ORB-SLAM2 RGB-D)
+  int min_motion_matches = 20;         // below: search again with twice the radius
+  int min_pose_inliers = 10;           // motion model / reference keyframe success
   int min_reference_matches = 15;
-  double local_map_search_radius = 3.0;   // ORB-SLAM2 RGB-D window factor
+  double local_map_search_radius = 3.0;  // ORB-SLAM2 RGB-D window factor
   int min_local_map_inliers = 30;
   int min_local_map_inliers_after_recovery = 50;
   size_t max_local_keyframes = 80;

@@ -11,5 +11,6 @@ int run_command(const std::vector<std::string>& args);
 int eval_command(const std::vector<std::string>& args);
 int synth_command(const std::vector<std::string>& args);
 int segment_command(const std::vector<std::string>& args);
+int vocab_command(const std::vector<std::string>& args);
 
 }  // namespace pspslam::cli

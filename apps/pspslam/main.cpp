@@ -22,6 +22,7 @@ const std::vector<Command>& commands() {
       {"synth", "render a synthetic dynamic RGB-D sequence", pspslam::cli::synth_command},
       {"segment", "segment images with an ONNX network (overlays, masks, timing)",
        pspslam::cli::segment_command},
+      {"vocab", "train / inspect the bag-of-words vocabulary", pspslam::cli::vocab_command},
   };
   return table;
 }

@@ -112,6 +112,7 @@ TEST(LocalMapper, BuildsCullsAndOptimisesASyntheticMap) {
     ++compared;
   }
   ASSERT_GT(compared, 0);
+  printf("DIAG depth %lu tri %lu culled %lu fused %lu kfculled %lu ba %lu int %lu out %lu last_ba %.3f last_kf %.3f err %.4f -> %.4f median tri err %.4f pts %zu kfs %zu\n", run.stats.points_from_depth, run.stats.points_triangulated, run.stats.points_culled, run.stats.points_fused, run.stats.keyframes_culled, run.stats.bundle_adjustments, run.stats.bundle_adjustments_interrupted, run.stats.ba_outliers_removed, run.stats.last_bundle_adjustment_seconds, run.stats.last_keyframe_seconds, error_before / compared, error_after / compared, errors[errors.size() / 2], run.map->num_map_points(), run.map->num_keyframes());
   EXPECT_LT(error_after, 0.3 * error_before)
       << "mean centre error " << error_before / compared << " -> " << error_after / compared;
   EXPECT_LT(error_after / compared, 0.01);

@@ -40,6 +40,8 @@ GeometryParams GeometryParams::from_yaml(YamlSection& section) {
   YamlSection region = section.section("region");
   p.region = RegionGrowParams::from_yaml(region);
   p.previous_mask_prior = section.optional("previous_mask_prior", p.previous_mask_prior);
+  p.output_warped_previous_mask =
+      section.optional("output_warped_previous_mask", p.output_warped_previous_mask);
   section.finish();
   return p;
 }
@@ -61,16 +63,19 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   GeometryFrameResult result;
 
   // III.B: camera-motion compensation of the previous frame (eq. 10-11).
+  const cv::Mat& previous_mask = input.previous_dynamic_mask;
+  const bool have_previous_mask = !previous_mask.empty() && previous_mask.type() == CV_8UC1;
+  Eigen::Matrix3d current_to_previous = Eigen::Matrix3d::Identity();
   if (input.matched_previous.size() >= 4) {
     result.homography = estimate_compensated_homography(input.matched_previous,
                                                         input.matched_current, params_.homography);
-    if (result.homography.valid && !input.previous_dynamic_mask.empty()) {
-      result.warped_previous_mask = warp_to_current(
-          input.previous_dynamic_mask, result.homography.H, input.depth.size(), true);
-    }
-  } else if (!input.previous_dynamic_mask.empty() &&
-             input.previous_dynamic_mask.size() == input.depth.size()) {
-    result.warped_previous_mask = input.previous_dynamic_mask;  // no motion estimate: identity
+    if (result.homography.valid) current_to_previous = result.homography.H.inverse();
+  }
+  if (have_previous_mask && params_.output_warped_previous_mask) {
+    result.warped_previous_mask =
+        result.homography.valid
+            ? warp_to_current(previous_mask, result.homography.H, input.depth.size(), true)
+            : previous_mask.clone();
   }
   result.timing.homography_ms = start.wall_ms();
   result.timing.homography_cpu_ms = start.cpu_ms();
@@ -93,10 +98,13 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
         depth = input.depth.at<float>(v, u);
     }
     candidates_[i] = {pixel, depth};
-    if (params_.previous_mask_prior && !result.warped_previous_mask.empty()) {
-      const int u = static_cast<int>(pixel.x()), v = static_cast<int>(pixel.y());
-      if (u >= 0 && v >= 0 && u < result.warped_previous_mask.cols &&
-          v < result.warped_previous_mask.rows && result.warped_previous_mask.at<std::uint8_t>(v, u))
+    if (params_.previous_mask_prior && have_previous_mask) {
+      // Where was this pixel in the previous frame? (inverse of the compensating homography)
+      const Eigen::Vector2d previous_pixel = transfer_point(current_to_previous, pixel);
+      const int u = static_cast<int>(std::floor(previous_pixel.x()));
+      const int v = static_cast<int>(std::floor(previous_pixel.y()));
+      if (u >= 0 && v >= 0 && u < previous_mask.cols && v < previous_mask.rows &&
+          previous_mask.at<std::uint8_t>(v, u))
         priority_.push_back(static_cast<int>(i));
     }
   }

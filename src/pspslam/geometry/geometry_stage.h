@@ -27,6 +27,9 @@ struct GeometryParams {
   // Test the points inside the previous frame's dynamic mask (warped into this frame by the
   // compensated homography) before walking the path.
   bool previous_mask_prior = true;
+  // Also return the previous mask warped into this frame (a full-image cv::warpPerspective, ~0.5 ms
+  // at 640x480). The prior itself needs no image: each keypoint is mapped back through H^-1.
+  bool output_warped_previous_mask = false;
 
   static GeometryParams from_yaml(YamlSection& section);
 };
@@ -69,7 +72,8 @@ struct GeometryFrameResult {
   int tested_dynamic_count = 0;
   int dynamic_count = 0;
   CompensatedHomography homography;  // valid = false when no matches were given
-  cv::Mat warped_previous_mask;      // previous mask in the motion-compensated frame (if given)
+  // Previous mask in the motion-compensated frame (only with output_warped_previous_mask).
+  cv::Mat warped_previous_mask;
   GeometryTiming timing;
 };
 

@@ -68,8 +68,9 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
   }
   const size_t cells = static_cast<size_t>(rows) * cols;
   region_of_.assign(cells, -1);
-  barrier_.assign(cells, 0);
-  if (params_.static_barrier_radius_px > 0.0f) {
+  const bool barriers = params_.static_barrier_radius_px > 0.0f;
+  barrier_.assign(barriers ? cells : 0, 0);
+  if (barriers) {
     const int radius = static_cast<int>(std::ceil(params_.static_barrier_radius_px / s));
     for (const Eigen::Vector2f& p : static_points) {
       const int cx = static_cast<int>(p.x()) / s, cy = static_cast<int>(p.y()) / s;
@@ -132,7 +133,7 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
         const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
         if (dx * dx + dy * dy > radius2) continue;
         const size_t next = static_cast<size_t>(ny) * cols + nx;
-        if (region_of_[next] >= 0 || barrier_[next]) continue;
+        if (region_of_[next] >= 0 || (barriers && barrier_[next])) continue;
         const float nd = grid_depth_.at<float>(ny, nx);
         if (!(nd > 0.0f) || std::abs(nd - d) > step ||
             std::abs(nd - seed_depth) > params_.max_depth_from_seed_m)
@@ -157,20 +158,25 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
   }
   // Full-resolution fill: a pixel of a grown block joins only if its own depth is continuous with
   // the block's sample, so silhouettes stay pixel-sharp although growth ran on the coarse grid.
-  const int x_end = std::min(depth.cols, (max_x + 1) * s);
-  const int y_end = std::min(depth.rows, (max_y + 1) * s);
-  for (int y = min_y * s; y < y_end; ++y) {
-    const int gy = y / s;
+  // Cell by cell (no per-pixel division); only rows and columns inside the grown bounding box.
+  const float step_abs = static_cast<float>(params_.max_step_abs_m);
+  const float step_relative = static_cast<float>(params_.max_step_relative);
+  for (int gy = min_y; gy <= max_y; ++gy) {
     const int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
     const float* samples = grid_depth_.ptr<float>(gy);
-    const float* row = depth.ptr<float>(y);
-    std::uint8_t* out = mask.ptr<std::uint8_t>(y);
-    for (int x = min_x * s; x < x_end; ++x) {
-      const int gx = x / s;
-      if (regions[gx] < 0) continue;  // mask was cleared above
+    const int y_end = std::min(depth.rows, (gy + 1) * s);
+    for (int gx = min_x; gx <= max_x; ++gx) {
+      if (regions[gx] < 0) continue;
       const float sample = samples[gx];
-      const double step = params_.max_step_abs_m + params_.max_step_relative * sample;
-      out[x] = row[x] > 0.0f && std::abs(row[x] - sample) <= step ? 255 : 0;
+      const float step = step_abs + step_relative * sample;
+      const int x0 = gx * s, x1 = std::min(depth.cols, x0 + s);
+      for (int y = gy * s; y < y_end; ++y) {
+        const float* row = depth.ptr<float>(y);
+        std::uint8_t* out = mask.ptr<std::uint8_t>(y);
+        for (int x = x0; x < x1; ++x) {
+          out[x] = row[x] > 0.0f && std::abs(row[x] - sample) <= step ? 255 : 0;
+        }
+      }
     }
   }
   if (params_.dilation_px > 0) {

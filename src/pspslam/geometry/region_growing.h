@@ -15,7 +15,7 @@ struct RegionGrowParams {
   bool enabled = true;
   // Growth runs on a grid of one depth sample per stride x stride block (speed; the mask is then
   // filled block-wise at full resolution).
-  int stride = 2;
+  int stride = 4;
   // Neighbouring samples belong to the same surface when their depths differ by at most
   // abs + relative * depth (depth continuity).
   double max_step_abs_m = 0.03;

@@ -1,0 +1,332 @@
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "pspslam/core/arg_parser.h"
+#include "pspslam/core/error.h"
+#include "pspslam/core/progress.h"
+#include "pspslam/feature/orb_extractor.h"
+#include "pspslam/place/vocabulary.h"
+#include "pspslam/synth/scene.h"
+
+namespace pspslam::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Synthetic training frames: kFramesPerSeed frames spread over one hand-held sequence per seed,
+// seeds first_seed, first_seed + 1, ... Tests and benchmarks use seeds below 1000.
+constexpr int kFramesPerSeed = 20;
+constexpr size_t kSynthSequenceFrames = 300;
+
+// Photographs are seen at three scales: the whole picture fitted into 640 x 480 (the size of the
+// frames the SLAM system sees), and fitted into 1280 x 960 and 2560 x 1920 cut into 640 x 480
+// tiles, which gives the finer texture a camera close to a surface sees (and more descriptors
+// from the few dozen photographs Debian ships).
+constexpr int kTileWidth = 640;
+constexpr int kTileHeight = 480;
+
+std::vector<fs::path> find_images(const std::vector<std::string>& dirs) {
+  std::vector<fs::path> images;
+  for (const std::string& dir : dirs) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+      throw Error("vocab train: --images '" + dir + "' is not a directory");
+    }
+    for (auto it = fs::recursive_directory_iterator(dir, fs::directory_options::follow_directory_symlink);
+         it != fs::recursive_directory_iterator(); ++it) {
+      if (!it->is_regular_file()) continue;
+      std::string ext = it->path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") images.push_back(it->path());
+    }
+  }
+  std::sort(images.begin(), images.end());
+  images.erase(std::unique(images.begin(), images.end()), images.end());
+  return images;
+}
+
+cv::Mat fit_into(const cv::Mat& gray, int width, int height) {
+  const double scale = std::min({1.0, static_cast<double>(width) / gray.cols,
+                                 static_cast<double>(height) / gray.rows});
+  if (scale >= 1.0) return gray;
+  cv::Mat resized;
+  cv::resize(gray, resized, cv::Size(), scale, scale, cv::INTER_AREA);
+  return resized;
+}
+
+// The training views of one photograph (see kTileWidth); pictures are never enlarged.
+std::vector<cv::Mat> photo_views(const cv::Mat& gray) {
+  std::vector<cv::Mat> views{fit_into(gray, kTileWidth, kTileHeight)};
+  cv::Size previous = views.front().size();
+  for (const int factor : {2, 4}) {
+    const cv::Mat large = fit_into(gray, factor * kTileWidth, factor * kTileHeight);
+    if (large.size() == previous) break;  // the picture is smaller than this scale
+    previous = large.size();
+    // Tiles at least half a tile high/wide; smaller edge remnants add little.
+    for (int y = 0; y + kTileHeight / 2 <= large.rows; y += kTileHeight) {
+      for (int x = 0; x + kTileWidth / 2 <= large.cols; x += kTileWidth) {
+        const cv::Rect tile(x, y, std::min(kTileWidth, large.cols - x),
+                            std::min(kTileHeight, large.rows - y));
+        views.push_back(large(tile).clone());
+      }
+    }
+  }
+  return views;
+}
+
+int train(const std::vector<std::string>& args) {
+  ArgParser parser("pspslam vocab train",
+                   "Train a bag-of-words vocabulary (hierarchical k-means over ORB descriptors, "
+                   "TF-IDF weights) from photographs and/or synthetic frames.");
+  parser.add_multi_option("images", "directory of training images (read recursively: jpg, png)");
+  parser.add_option("synthetic-frames", "synthetic frames to add (20 per seed)", "0");
+  parser.add_option("synthetic-seed", "first synth seed (tests use seeds < 1000)", "1000");
+  parser.add_option("out", "vocabulary file to write", "", true);
+  parser.add_option("k", "branching factor", "10");
+  parser.add_option("levels", "tree depth L", "5");
+  parser.add_option("max-descriptors", "random subsample of descriptors for k-means", "1500000");
+  parser.add_option("iterations", "k-means iterations per node (at most)", "10");
+  parser.add_option("seed", "random seed (subsampling, k-means++)", "1");
+  if (!parser.parse(args)) return 0;
+
+  VocabularyParams params;
+  params.branching = parser.get_int("k");
+  params.levels = parser.get_int("levels");
+  params.max_iterations = parser.get_int("iterations");
+  const int seed = parser.get_int("seed");
+  if (seed < 0) throw Error("vocab train: --seed must be >= 0, got " + parser.get("seed"));
+  params.seed = static_cast<std::uint64_t>(seed);
+  params.validate();
+  const int synthetic_frames = parser.get_int("synthetic-frames");
+  if (synthetic_frames < 0) {
+    throw Error("vocab train: --synthetic-frames must be >= 0, got " +
+                parser.get("synthetic-frames"));
+  }
+  const int synthetic_seed = parser.get_int("synthetic-seed");
+  if (synthetic_seed < 1000) {
+    throw Error("vocab train: --synthetic-seed must be >= 1000 (seeds below are reserved for "
+                "tests and benchmarks), got " + parser.get("synthetic-seed"));
+  }
+  const int max_descriptors = parser.get_int("max-descriptors");
+  if (max_descriptors < params.branching) {
+    throw Error("vocab train: --max-descriptors must be >= --k, got " +
+                parser.get("max-descriptors"));
+  }
+  const fs::path out = parser.get("out");
+  const std::vector<fs::path> photos = find_images(parser.get_all("images"));
+  if (photos.empty() && synthetic_frames == 0) {
+    throw Error("vocab train: no training data: give --images DIR (with jpg/png files) and/or "
+                "--synthetic-frames N");
+  }
+
+  const auto start = Clock::now();
+  OrbExtractor extractor{OrbConfig{}};
+  OrbFeatures features;
+  std::vector<cv::Mat> image_descriptors;
+  std::size_t total_descriptors = 0;
+  auto add_view = [&](const cv::Mat& gray) {
+    extractor.extract(gray, cv::Mat(), features);
+    if (features.descriptors.rows == 0) return;
+    image_descriptors.push_back(features.descriptors.clone());
+    total_descriptors += static_cast<std::size_t>(features.descriptors.rows);
+  };
+
+  std::cout << "training images: " << photos.size() << " photographs, " << synthetic_frames
+            << " synthetic frames\n";
+  ProgressBar extract_progress("orb", photos.size() + static_cast<size_t>(synthetic_frames),
+                               std::cerr);
+  size_t done = 0;
+  size_t photo_views_used = 0;
+  for (const fs::path& photo : photos) {
+    const cv::Mat gray = cv::imread(photo.string(), cv::IMREAD_GRAYSCALE);
+    if (gray.empty()) throw Error("vocab train: cannot read image '" + photo.string() + "'");
+    for (const cv::Mat& view : photo_views(gray)) {
+      add_view(view);
+      ++photo_views_used;
+    }
+    extract_progress.update(++done);
+  }
+  if (synthetic_frames > 0) {
+    SynthFrame frame;
+    cv::Mat gray;
+    for (int first = 0; first < synthetic_frames; first += kFramesPerSeed) {
+      SynthOptions options;
+      options.frames = kSynthSequenceFrames;
+      options.seed = static_cast<std::uint64_t>(synthetic_seed + first / kFramesPerSeed);
+      const SyntheticScene scene(options);
+      const int count = std::min(kFramesPerSeed, synthetic_frames - first);
+      for (int i = 0; i < count; ++i) {
+        scene.render(static_cast<size_t>(i) * (kSynthSequenceFrames / kFramesPerSeed), frame, 0);
+        cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+        add_view(gray);
+        extract_progress.update(++done);
+      }
+    }
+  }
+  extract_progress.finish();
+  std::cout << "descriptors: " << total_descriptors << " from " << image_descriptors.size()
+            << " images (" << photo_views_used << " photo views), extraction "
+            << seconds_since(start) << " s\n";
+  if (total_descriptors < static_cast<std::size_t>(params.branching)) {
+    throw Error("vocab train: only " + std::to_string(total_descriptors) +
+                " descriptors found, need at least --k");
+  }
+
+  // Uniform random subsample for the tree (k-means cost grows with it); IDF uses every image.
+  std::vector<std::uint32_t> order(total_descriptors);
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::mt19937_64 rng(params.seed);
+  const std::size_t sample =
+      std::min(total_descriptors, static_cast<std::size_t>(max_descriptors));
+  if (sample < total_descriptors) {
+    std::shuffle(order.begin(), order.end(), rng);
+    order.resize(sample);
+    std::sort(order.begin(), order.end());
+  }
+  cv::Mat tree_descriptors(static_cast<int>(sample), kOrbDescriptorBytes, CV_8UC1);
+  {
+    std::size_t image = 0;
+    std::size_t image_start = 0;
+    for (std::size_t i = 0; i < sample; ++i) {
+      while (order[i] >= image_start + static_cast<std::size_t>(image_descriptors[image].rows)) {
+        image_start += static_cast<std::size_t>(image_descriptors[image].rows);
+        ++image;
+      }
+      image_descriptors[image]
+          .row(static_cast<int>(order[i] - image_start))
+          .copyTo(tree_descriptors.row(static_cast<int>(i)));
+    }
+  }
+
+  const auto kmeans_start = Clock::now();
+  ProgressBar tree_progress("k-means", sample, std::cerr);
+  ProgressBar idf_progress("idf", image_descriptors.size(), std::cerr);
+  const Vocabulary vocabulary = Vocabulary::train(
+      tree_descriptors, image_descriptors, params,
+      [&](const std::string& stage, std::size_t n, std::size_t total) {
+        if (stage == "tree") {
+          tree_progress.update(n);
+          if (n == total) tree_progress.finish();
+        } else {
+          idf_progress.update(n);
+          if (n == total) idf_progress.finish();
+        }
+      });
+  const double kmeans_seconds = seconds_since(kmeans_start);
+  vocabulary.save(out);
+  const double total_seconds = seconds_since(start);
+
+  const auto load_start = Clock::now();
+  const Vocabulary reloaded = Vocabulary::load(out);
+  const double load_seconds = seconds_since(load_start);
+  std::cout << "vocabulary: k " << vocabulary.branching() << ", L " << vocabulary.levels() << ", "
+            << vocabulary.node_count() << " nodes, " << vocabulary.word_count() << " words, "
+            << sample << " descriptors clustered (of " << total_descriptors << "), "
+            << image_descriptors.size() << " images for IDF\n"
+            << "time: k-means + IDF " << kmeans_seconds << " s, total " << total_seconds
+            << " s\nwrote " << out.string() << " (" << fs::file_size(out) << " bytes), loads in "
+            << load_seconds * 1e3 << " ms (" << reloaded.word_count() << " words)\n";
+  return 0;
+}
+
+int info(const std::vector<std::string>& args) {
+  ArgParser parser("pspslam vocab info",
+                   "Load a vocabulary, print its shape, load time and the speed of descriptor -> "
+                   "word lookup on synthetic frames.");
+  parser.add_option("vocabulary", "vocabulary file", "", true);
+  parser.add_option("frames", "synthetic frames to time lookups on", "20");
+  parser.add_option("repeat", "lookup passes over the descriptors", "5");
+  if (!parser.parse(args)) return 0;
+  const fs::path file = parser.get("vocabulary");
+  const int frames = std::max(1, parser.get_int("frames"));
+  const int repeat = std::max(1, parser.get_int("repeat"));
+
+  const auto load_start = Clock::now();
+  const Vocabulary vocabulary = Vocabulary::load(file);
+  const double load_ms = seconds_since(load_start) * 1e3;
+  std::size_t weighted = 0;
+  for (WordId w = 0; w < vocabulary.word_count(); ++w) weighted += vocabulary.word_weight(w) > 0;
+  std::cout << file.string() << ": " << fs::file_size(file) << " bytes, loaded in " << load_ms
+            << " ms\n  k " << vocabulary.branching() << ", L " << vocabulary.levels() << ", "
+            << vocabulary.node_count() << " nodes, " << vocabulary.word_count() << " words ("
+            << weighted << " with IDF > 0), trained on " << vocabulary.training_images()
+            << " images\n";
+
+  SynthOptions options;
+  options.frames = 300;
+  options.seed = 1;
+  const SyntheticScene scene(options);
+  OrbExtractor extractor{OrbConfig{}};
+  OrbFeatures features;
+  SynthFrame frame;
+  cv::Mat gray;
+  std::vector<cv::Mat> descriptors;
+  std::size_t count = 0;
+  for (int i = 0; i < frames; ++i) {
+    scene.render(static_cast<size_t>(i * 7) % options.frames, frame, 0);
+    cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    extractor.extract(gray, cv::Mat(), features);
+    descriptors.push_back(features.descriptors.clone());
+    count += static_cast<std::size_t>(features.descriptors.rows);
+  }
+  std::uint64_t checksum = 0;  // keeps the lookups from being optimised away
+  const auto lookup_start = Clock::now();
+  for (int r = 0; r < repeat; ++r) {
+    for (const cv::Mat& d : descriptors) {
+      for (int row = 0; row < d.rows; ++row) checksum += vocabulary.word(d.ptr<std::uint8_t>(row));
+    }
+  }
+  const double lookup_us = seconds_since(lookup_start) * 1e6;
+  BowVector bow;
+  FeatureVector direct;
+  const auto transform_start = Clock::now();
+  for (int r = 0; r < repeat; ++r) {
+    for (const cv::Mat& d : descriptors) {
+      vocabulary.transform(d, bow, direct, std::min(2, vocabulary.levels()));
+      checksum += bow.size();
+    }
+  }
+  const double transform_us = seconds_since(transform_start) * 1e6;
+  std::cout << std::fixed << std::setprecision(1) << "  lookup: "
+            << lookup_us / (static_cast<double>(count) * repeat) * 1000.0
+            << " us per 1000 descriptors (" << count << " descriptors from " << frames
+            << " synthetic frames x " << repeat << ")\n  transform (BoW + direct index, level 2): "
+            << transform_us / (static_cast<double>(frames) * repeat)
+            << " us per frame (~" << count / frames << " descriptors)  [" << checksum % 10
+            << "]\n";
+  return 0;
+}
+
+}  // namespace
+
+int vocab_command(const std::vector<std::string>& args) {
+  const std::string usage =
+      "usage: pspslam vocab train|info [flags]   (pspslam vocab <sub-command> --help)";
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::cout << usage << "\n  train  train a bag-of-words vocabulary\n"
+              << "  info   load a vocabulary, print its shape, load time and lookup speed\n";
+    return args.empty() ? 2 : 0;
+  }
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  if (args[0] == "train") return train(rest);
+  if (args[0] == "info") return info(rest);
+  throw Error("vocab: unknown sub-command '" + args[0] + "' (" + usage + ")");
+}
+
+}  // namespace pspslam::cli

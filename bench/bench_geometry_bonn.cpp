@@ -61,7 +61,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 struct Frame {
-  cv::Mat depth;  // undistorted, metres
+  cv::Mat depth;                           // undistorted, metres
   std::vector<Eigen::Vector2d> keypoints;  // undistorted pixels with a depth reading
   std::vector<float> depths;
   cv::Mat descriptors;  // rows of the keypoints above
@@ -93,9 +93,10 @@ int main(int argc, char** argv) {
   std::vector<Frame> frames;
   std::vector<int> frame_index;
   for (size_t i = 0; i < rgb.size() && static_cast<int>(frames.size()) < max_frames; ++i) {
-    const auto nearest = std::min_element(depth_list.begin(), depth_list.end(), [&](const Entry& a, const Entry& b) {
-      return std::abs(a.t - rgb[i].t) < std::abs(b.t - rgb[i].t);
-    });
+    const auto nearest =
+        std::min_element(depth_list.begin(), depth_list.end(), [&](const Entry& a, const Entry& b) {
+          return std::abs(a.t - rgb[i].t) < std::abs(b.t - rgb[i].t);
+        });
     if (std::abs(nearest->t - rgb[i].t) > 0.02 || !fs::exists(dir / nearest->file)) continue;
     const cv::Mat bgr = cv::imread((dir / rgb[i].file).string());
     const cv::Mat raw = cv::imread((dir / nearest->file).string(), cv::IMREAD_ANYDEPTH);
@@ -133,7 +134,8 @@ int main(int argc, char** argv) {
   cv::BFMatcher matcher(cv::NORM_HAMMING, true);  // cross-checked matches
   const auto match = [&](const Frame& a, const Frame& b) {
     std::vector<cv::DMatch> m;
-    if (!a.descriptors.empty() && !b.descriptors.empty()) matcher.match(a.descriptors, b.descriptors, m);
+    if (!a.descriptors.empty() && !b.descriptors.empty())
+      matcher.match(a.descriptors, b.descriptors, m);
     std::vector<cv::DMatch> good;
     for (const cv::DMatch& d : m)
       if (d.distance < 50) good.push_back(d);
@@ -188,9 +190,11 @@ int main(int argc, char** argv) {
       std::vector<cv::Point3f> object;
       std::vector<cv::Point2f> image;
       for (const cv::DMatch& d : m) {
-        const Eigen::Vector3d p = ideal.unproject(ref.keypoints[d.trainIdx], ref.depths[d.trainIdx]);
+        const Eigen::Vector3d p =
+            ideal.unproject(ref.keypoints[d.trainIdx], ref.depths[d.trainIdx]);
         object.emplace_back(p.x(), p.y(), p.z());
-        image.emplace_back(frames[i].keypoints[d.queryIdx].x(), frames[i].keypoints[d.queryIdx].y());
+        image.emplace_back(frames[i].keypoints[d.queryIdx].x(),
+                           frames[i].keypoints[d.queryIdx].y());
       }
       if (object.size() < 20) continue;
       cv::Mat rvec, tvec;
@@ -232,7 +236,8 @@ int main(int argc, char** argv) {
     ant_wall.push_back(a.timing.total_ms);
     ex_search.push_back(e.timing.search_cpu_ms);
     ant_search.push_back(a.timing.search_cpu_ms);
-    tested_share.push_back(double(a.tested_count) / std::max<size_t>(1, frames[i].keypoints.size()));
+    tested_share.push_back(double(a.tested_count) /
+                           std::max<size_t>(1, frames[i].keypoints.size()));
     for (size_t k = 0; k < frames[i].keypoints.size(); ++k) {
       found += e.keypoint_tested_dynamic[k];
       kept += e.keypoint_tested_dynamic[k] && a.keypoint_tested_dynamic[k];
@@ -251,13 +256,15 @@ int main(int argc, char** argv) {
               "ant_colony", median(ant_cpu), median(ant_wall), median(ant_search));
   std::printf("  %-11s module cpu median %.3f ms (wall %.3f ms), search cpu median %.3f ms\n",
               "exhaustive", median(ex_cpu), median(ex_wall), median(ex_search));
-  std::printf("  ratio ant/exhaustive of medians: module %.3f, search %.3f; ant tests %.3f of points "
-              "(median); keeps %.3f of exhaustive detections (%ld of %ld)\n",
-              median(ant_cpu) / median(ex_cpu), median(ant_search) / median(ex_search),
-              median(tested_share), double(kept) / std::max(1L, found), kept, found);
-  std::printf("  dynamic share of keypoints (ant colony, final flags): static room frames <215 "
-              "%.4f, crowd frames >=220 %.4f\n",
-              double(static_flags) / std::max(1L, static_points),
-              double(crowd_flags) / std::max(1L, crowd_points));
+  std::printf(
+      "  ratio ant/exhaustive of medians: module %.3f, search %.3f; ant tests %.3f of points "
+      "(median); keeps %.3f of exhaustive detections (%ld of %ld)\n",
+      median(ant_cpu) / median(ex_cpu), median(ant_search) / median(ex_search),
+      median(tested_share), double(kept) / std::max(1L, found), kept, found);
+  std::printf(
+      "  dynamic share of keypoints (ant colony, final flags): static room frames <215 "
+      "%.4f, crowd frames >=220 %.4f\n",
+      double(static_flags) / std::max(1L, static_points),
+      double(crowd_flags) / std::max(1L, crowd_points));
   return 0;
 }

@@ -140,7 +140,11 @@ void BM_GeometryStage(benchmark::State& state) {
   input.matched_current = f.matched_current;
   for (auto _ : state) benchmark::DoNotOptimize(stage.process(input));
 }
-BENCHMARK(BM_GeometryStage)->Arg(0)->Arg(1)->ArgNames({"exhaustive"})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_GeometryStage)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgNames({"exhaustive"})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

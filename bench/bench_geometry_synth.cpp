@@ -31,22 +31,39 @@ struct Options {
 };
 
 void apply(GeometryParams& p, const std::string& key, double value) {
-  if (key == "depth_threshold_abs_m") p.multiview.depth_threshold_abs_m = value;
-  else if (key == "depth_threshold_relative") p.multiview.depth_threshold_relative = value;
-  else if (key == "either_sign") p.multiview.disagreement = value > 0 ? DepthDisagreement::either_sign : DepthDisagreement::farther_only;
-  else if (key == "reference_patch_radius") p.multiview.reference_patch_radius = int(value);
-  else if (key == "min_dynamic_vote_fraction") p.multiview.min_dynamic_vote_fraction = value;
-  else if (key == "max_parallax_deg") p.multiview.max_parallax_deg = value;
-  else if (key == "search_radius_px") p.search.search_radius_px = float(value);
-  else if (key == "band_width_px") p.search.band_width_px = float(value);
-  else if (key == "node_spacing_px") p.search.node_spacing_px = float(value);
-  else if (key == "lane_spacing_px") p.search.lane_spacing_px = float(value);
-  else if (key == "region") p.region.enabled = value > 0;
-  else if (key == "stride") p.region.stride = int(value);
-  else if (key == "max_grow_radius_px") p.region.max_grow_radius_px = float(value);
-  else if (key == "min_seeds_per_region") p.region.min_seeds_per_region = int(value);
-  else if (key == "max_depth_from_seed_m") p.region.max_depth_from_seed_m = value;
-  else if (key == "dilation_px") p.region.dilation_px = int(value);
+  if (key == "depth_threshold_abs_m")
+    p.multiview.depth_threshold_abs_m = value;
+  else if (key == "depth_threshold_relative")
+    p.multiview.depth_threshold_relative = value;
+  else if (key == "either_sign")
+    p.multiview.disagreement =
+        value > 0 ? DepthDisagreement::either_sign : DepthDisagreement::farther_only;
+  else if (key == "reference_patch_radius")
+    p.multiview.reference_patch_radius = int(value);
+  else if (key == "min_dynamic_vote_fraction")
+    p.multiview.min_dynamic_vote_fraction = value;
+  else if (key == "max_parallax_deg")
+    p.multiview.max_parallax_deg = value;
+  else if (key == "search_radius_px")
+    p.search.search_radius_px = float(value);
+  else if (key == "band_width_px")
+    p.search.band_width_px = float(value);
+  else if (key == "node_spacing_px")
+    p.search.node_spacing_px = float(value);
+  else if (key == "lane_spacing_px")
+    p.search.lane_spacing_px = float(value);
+  else if (key == "region")
+    p.region.enabled = value > 0;
+  else if (key == "stride")
+    p.region.stride = int(value);
+  else if (key == "max_grow_radius_px")
+    p.region.max_grow_radius_px = float(value);
+  else if (key == "min_seeds_per_region")
+    p.region.min_seeds_per_region = int(value);
+  else if (key == "max_depth_from_seed_m")
+    p.region.max_depth_from_seed_m = value;
+  else if (key == "dilation_px")
+    p.region.dilation_px = int(value);
   else {
     std::fprintf(stderr, "unknown key --%s\n", key.c_str());
     std::exit(2);
@@ -58,9 +75,9 @@ Pose perturbed(const Pose& T, double mm, double deg, std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
   Pose d = Pose::Identity();
   d.translation() = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * mm * 1e-3;
-  d.linear() = Eigen::AngleAxisd(deg * M_PI / 180.0,
-                                 Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
-                   .toRotationMatrix();
+  d.linear() =
+      Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
+          .toRotationMatrix();
   return T * d;
 }
 
@@ -86,8 +103,8 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-Counts run(const GeometryParams& params, const PinholeCamera& camera, const std::vector<Frame>& frames,
-           std::vector<std::uint8_t>* tested_dynamic) {
+Counts run(const GeometryParams& params, const PinholeCamera& camera,
+           const std::vector<Frame>& frames, std::vector<std::uint8_t>* tested_dynamic) {
   Counts c;
   GeometryStage stage(camera, params);
   for (const Frame& f : frames) {
@@ -98,11 +115,15 @@ Counts run(const GeometryParams& params, const PinholeCamera& camera, const std:
     input.references = f.references;
     const GeometryFrameResult r = stage.process(input);
     for (size_t i = 0; i < f.keypoints.size(); ++i) {
-      const bool truth =
-          f.labels.at<std::uint8_t>(int(f.keypoints[i].y() + 0.5), int(f.keypoints[i].x() + 0.5)) != 0;
+      const bool truth = f.labels.at<std::uint8_t>(int(f.keypoints[i].y() + 0.5),
+                                                   int(f.keypoints[i].x() + 0.5)) != 0;
       const bool flag = r.keypoint_dynamic[i], test = r.keypoint_tested_dynamic[i];
-      c.tp += truth && flag; c.fp += !truth && flag; c.fn += truth && !flag;
-      c.test_tp += truth && test; c.test_fp += !truth && test; c.test_fn += truth && !test;
+      c.tp += truth && flag;
+      c.fp += !truth && flag;
+      c.fn += truth && !flag;
+      c.test_tp += truth && test;
+      c.test_fp += !truth && test;
+      c.test_fn += truth && !test;
       if (tested_dynamic) tested_dynamic->push_back(test);
     }
     c.tested += r.tested_count;
@@ -126,12 +147,18 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = std::string(argv[i]).substr(2);
     const double value = std::stod(argv[i + 1]);
-    if (key == "seeds") o.seeds = int(value);
-    else if (key == "frames-per-seed") o.frames_per_seed = int(value);
-    else if (key == "bodies") o.bodies = int(value);
-    else if (key == "pose_noise_mm") o.pose_noise_mm = value;
-    else if (key == "pose_noise_deg") o.pose_noise_deg = value;
-    else o.overrides.emplace_back(key, value);
+    if (key == "seeds")
+      o.seeds = int(value);
+    else if (key == "frames-per-seed")
+      o.frames_per_seed = int(value);
+    else if (key == "bodies")
+      o.bodies = int(value);
+    else if (key == "pose_noise_mm")
+      o.pose_noise_mm = value;
+    else if (key == "pose_noise_deg")
+      o.pose_noise_deg = value;
+    else
+      o.overrides.emplace_back(key, value);
   }
   GeometryParams params;
   for (const auto& [k, v] : o.overrides) apply(params, k, v);
@@ -156,8 +183,9 @@ int main(int argc, char** argv) {
       for (int r = 1; r <= 5; ++r) {
         SynthFrame ref;
         scene.render(current - 10 * r, ref, 2);
-        f.references.push_back({perturbed(ref.T_world_camera, o.pose_noise_mm, o.pose_noise_deg, rng),
-                                ref.depth_sensor.clone()});
+        f.references.push_back(
+            {perturbed(ref.T_world_camera, o.pose_noise_mm, o.pose_noise_deg, rng),
+             ref.depth_sensor.clone()});
       }
       SynthFrame now;
       scene.render(current, now, 2);
@@ -179,10 +207,11 @@ int main(int argc, char** argv) {
       frames.push_back(std::move(f));
     }
   }
-  std::printf("synth: %d seeds x %d frames, %d bodies, pose noise %.1f mm / %.2f deg; %.0f ORB "
-              "candidates/frame, dynamic share %.3f\n",
-              o.seeds, o.frames_per_seed, o.bodies, o.pose_noise_mm, o.pose_noise_deg,
-              double(all_points) / frames.size(), double(dynamic_points) / std::max(1L, all_points));
+  std::printf(
+      "synth: %d seeds x %d frames, %d bodies, pose noise %.1f mm / %.2f deg; %.0f ORB "
+      "candidates/frame, dynamic share %.3f\n",
+      o.seeds, o.frames_per_seed, o.bodies, o.pose_noise_mm, o.pose_noise_deg,
+      double(all_points) / frames.size(), double(dynamic_points) / std::max(1L, all_points));
   std::printf("%-12s %7s %7s %7s %7s %7s %8s %10s\n", "strategy", "recall", "prec", "t_rec",
               "t_prec", "tested", "cpu_ms", "search_cpu");
   GeometryParams ant = params, exhaustive = params;
@@ -206,8 +235,9 @@ int main(int argc, char** argv) {
     found += flags_exhaustive[i];
     kept += flags_exhaustive[i] && flags_ant[i];
   }
-  std::printf("ant colony keeps %.3f of the exhaustive test's dynamic detections (%ld of %ld); "
-              "time ratio ant/exhaustive (median of 5 runs): module %.3f, search %.3f\n",
-              double(kept) / std::max(1L, found), kept, found, median(ratios), median(search_ratios));
+  std::printf(
+      "ant colony keeps %.3f of the exhaustive test's dynamic detections (%ld of %ld); "
+      "time ratio ant/exhaustive (median of 5 runs): module %.3f, search %.3f\n",
+      double(kept) / std::max(1L, found), kept, found, median(ratios), median(search_ratios));
   return 0;
 }

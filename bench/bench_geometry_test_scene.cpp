@@ -21,22 +21,32 @@ namespace {
 using namespace pspslam;
 
 struct Metrics {
-  long tp = 0, fp = 0, fn = 0, tn = 0;          // final per-keypoint flags
-  long test_tp = 0, test_fp = 0, test_fn = 0;   // tested-dynamic flags only
+  long tp = 0, fp = 0, fn = 0, tn = 0;         // final per-keypoint flags
+  long test_tp = 0, test_fp = 0, test_fn = 0;  // tested-dynamic flags only
   long tested = 0, candidates = 0;
   std::vector<double> total_ms, search_ms, region_ms;
   void add(const Metrics& o) {
-    tp += o.tp; fp += o.fp; fn += o.fn; tn += o.tn;
-    test_tp += o.test_tp; test_fp += o.test_fp; test_fn += o.test_fn;
-    tested += o.tested; candidates += o.candidates;
+    tp += o.tp;
+    fp += o.fp;
+    fn += o.fn;
+    tn += o.tn;
+    test_tp += o.test_tp;
+    test_fp += o.test_fp;
+    test_fn += o.test_fn;
+    tested += o.tested;
+    candidates += o.candidates;
     total_ms.insert(total_ms.end(), o.total_ms.begin(), o.total_ms.end());
     search_ms.insert(search_ms.end(), o.search_ms.begin(), o.search_ms.end());
     region_ms.insert(region_ms.end(), o.region_ms.begin(), o.region_ms.end());
   }
   double recall() const { return tp + fn ? double(tp) / (tp + fn) : 1.0; }
   double precision() const { return tp + fp ? double(tp) / (tp + fp) : 1.0; }
-  double test_recall() const { return test_tp + test_fn ? double(test_tp) / (test_tp + test_fn) : 1.0; }
-  double test_precision() const { return test_tp + test_fp ? double(test_tp) / (test_tp + test_fp) : 1.0; }
+  double test_recall() const {
+    return test_tp + test_fn ? double(test_tp) / (test_tp + test_fn) : 1.0;
+  }
+  double test_precision() const {
+    return test_tp + test_fp ? double(test_tp) / (test_tp + test_fp) : 1.0;
+  }
   double median_ms() const { return median(total_ms); }
   static double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
@@ -56,27 +66,49 @@ struct Options {
 };
 
 void apply(GeometryParams& p, const std::string& key, double value) {
-  if (key == "depth_threshold_abs_m") p.multiview.depth_threshold_abs_m = value;
-  else if (key == "depth_threshold_relative") p.multiview.depth_threshold_relative = value;
-  else if (key == "either_sign") p.multiview.disagreement = value > 0 ? DepthDisagreement::either_sign : DepthDisagreement::farther_only;
-  else if (key == "max_parallax_deg") p.multiview.max_parallax_deg = value;
-  else if (key == "reference_patch_radius") p.multiview.reference_patch_radius = int(value);
-  else if (key == "min_dynamic_vote_fraction") p.multiview.min_dynamic_vote_fraction = value;
-  else if (key == "max_reference_views") p.multiview.max_reference_views = int(value);
-  else if (key == "search_radius_px") p.search.search_radius_px = float(value);
-  else if (key == "band_width_px") p.search.band_width_px = float(value);
-  else if (key == "node_spacing_px") p.search.node_spacing_px = float(value);
-  else if (key == "lane_spacing_px") p.search.lane_spacing_px = float(value);
-  else if (key == "exhaustive") p.search.strategy = value > 0 ? SearchStrategy::exhaustive : SearchStrategy::ant_colony;
-  else if (key == "region") p.region.enabled = value > 0;
-  else if (key == "stride") p.region.stride = int(value);
-  else if (key == "max_step_abs_m") p.region.max_step_abs_m = value;
-  else if (key == "max_step_relative") p.region.max_step_relative = value;
-  else if (key == "max_depth_from_seed_m") p.region.max_depth_from_seed_m = value;
-  else if (key == "static_barrier_radius_px") p.region.static_barrier_radius_px = float(value);
-  else if (key == "max_grow_radius_px") p.region.max_grow_radius_px = float(value);
-  else if (key == "min_seeds_per_region") p.region.min_seeds_per_region = int(value);
-  else if (key == "dilation_px") p.region.dilation_px = int(value);
+  if (key == "depth_threshold_abs_m")
+    p.multiview.depth_threshold_abs_m = value;
+  else if (key == "depth_threshold_relative")
+    p.multiview.depth_threshold_relative = value;
+  else if (key == "either_sign")
+    p.multiview.disagreement =
+        value > 0 ? DepthDisagreement::either_sign : DepthDisagreement::farther_only;
+  else if (key == "max_parallax_deg")
+    p.multiview.max_parallax_deg = value;
+  else if (key == "reference_patch_radius")
+    p.multiview.reference_patch_radius = int(value);
+  else if (key == "min_dynamic_vote_fraction")
+    p.multiview.min_dynamic_vote_fraction = value;
+  else if (key == "max_reference_views")
+    p.multiview.max_reference_views = int(value);
+  else if (key == "search_radius_px")
+    p.search.search_radius_px = float(value);
+  else if (key == "band_width_px")
+    p.search.band_width_px = float(value);
+  else if (key == "node_spacing_px")
+    p.search.node_spacing_px = float(value);
+  else if (key == "lane_spacing_px")
+    p.search.lane_spacing_px = float(value);
+  else if (key == "exhaustive")
+    p.search.strategy = value > 0 ? SearchStrategy::exhaustive : SearchStrategy::ant_colony;
+  else if (key == "region")
+    p.region.enabled = value > 0;
+  else if (key == "stride")
+    p.region.stride = int(value);
+  else if (key == "max_step_abs_m")
+    p.region.max_step_abs_m = value;
+  else if (key == "max_step_relative")
+    p.region.max_step_relative = value;
+  else if (key == "max_depth_from_seed_m")
+    p.region.max_depth_from_seed_m = value;
+  else if (key == "static_barrier_radius_px")
+    p.region.static_barrier_radius_px = float(value);
+  else if (key == "max_grow_radius_px")
+    p.region.max_grow_radius_px = float(value);
+  else if (key == "min_seeds_per_region")
+    p.region.min_seeds_per_region = int(value);
+  else if (key == "dilation_px")
+    p.region.dilation_px = int(value);
   else {
     std::fprintf(stderr, "unknown key %s\n", key.c_str());
     std::exit(2);
@@ -88,8 +120,9 @@ Pose perturbed(const Pose& T, double mm, double deg, std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
   Pose d = Pose::Identity();
   d.translation() = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * mm * 1e-3;
-  d.linear() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
-                   .toRotationMatrix();
+  d.linear() =
+      Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized())
+          .toRotationMatrix();
   return T * d;
 }
 
@@ -167,12 +200,17 @@ Metrics evaluate(const GeometryParams& params, const Dataset& data, RunFlags* fl
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu_end);
     Metrics m;
     for (size_t i = 0; i < frame.keypoints.size(); ++i) {
-      const bool truth =
-          frame.labels.at<std::uint8_t>(int(frame.keypoints[i].y()), int(frame.keypoints[i].x())) != 0;
+      const bool truth = frame.labels.at<std::uint8_t>(int(frame.keypoints[i].y()),
+                                                       int(frame.keypoints[i].x())) != 0;
       const bool flag = r.keypoint_dynamic[i];
       const bool tested_flag = r.keypoint_tested_dynamic[i];
-      m.tp += truth && flag; m.fp += !truth && flag; m.fn += truth && !flag; m.tn += !truth && !flag;
-      m.test_tp += truth && tested_flag; m.test_fp += !truth && tested_flag; m.test_fn += truth && !tested_flag;
+      m.tp += truth && flag;
+      m.fp += !truth && flag;
+      m.fn += truth && !flag;
+      m.tn += !truth && !flag;
+      m.test_tp += truth && tested_flag;
+      m.test_fp += !truth && tested_flag;
+      m.test_fn += truth && !tested_flag;
       if (flags != nullptr) flags->tested_dynamic.push_back(tested_flag);
     }
     m.tested = r.tested_count;
@@ -207,14 +245,22 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = std::string(argv[i]).substr(2);
     const std::string value = argv[i + 1];
-    if (key == "frames") o.frames = std::stoi(value);
-    else if (key == "seeds") o.seeds = std::stoi(value);
-    else if (key == "width") o.width = std::stoi(value);
-    else if (key == "keypoints") o.keypoints = std::stoi(value);
-    else if (key == "pose_noise_mm") o.pose_noise_mm = std::stod(value);
-    else if (key == "pose_noise_deg") o.pose_noise_deg = std::stod(value);
-    else if (key == "sweep") sweep = value;
-    else overrides.emplace_back(key, std::stod(value));
+    if (key == "frames")
+      o.frames = std::stoi(value);
+    else if (key == "seeds")
+      o.seeds = std::stoi(value);
+    else if (key == "width")
+      o.width = std::stoi(value);
+    else if (key == "keypoints")
+      o.keypoints = std::stoi(value);
+    else if (key == "pose_noise_mm")
+      o.pose_noise_mm = std::stod(value);
+    else if (key == "pose_noise_deg")
+      o.pose_noise_deg = std::stod(value);
+    else if (key == "sweep")
+      sweep = value;
+    else
+      overrides.emplace_back(key, std::stod(value));
   }
   GeometryParams base;
   for (const auto& [k, v] : overrides) apply(base, k, v);
@@ -245,9 +291,10 @@ int main(int argc, char** argv) {
       kept += exhaustive_flags.tested_dynamic[i] && ant_flags.tested_dynamic[i];
     }
     std::sort(ratios.begin(), ratios.end());
-    std::printf("ant colony keeps %.3f of exhaustive detections (%ld of %ld); time ratio (median of "
-                "5 runs) %.3f\n",
-                double(kept) / std::max(1L, found), kept, found, ratios[ratios.size() / 2]);
+    std::printf(
+        "ant colony keeps %.3f of exhaustive detections (%ld of %ld); time ratio (median of "
+        "5 runs) %.3f\n",
+        double(kept) / std::max(1L, found), kept, found, ratios[ratios.size() / 2]);
     return 0;
   }
   if (sweep.empty()) {
@@ -261,7 +308,8 @@ int main(int argc, char** argv) {
   size_t start = 0;
   while (start <= list.size()) {
     const size_t comma = list.find(',', start);
-    const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::string item =
+        list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     GeometryParams p = base;
     apply(p, key, std::stod(item));
     print_row(key + "=" + item, evaluate(p, data));

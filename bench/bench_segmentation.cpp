@@ -55,8 +55,8 @@ double validation_iou(OnnxSegmenter& segmenter, const fs::path& shared, int* cou
   for (int id : split["val"].as<std::vector<int>>()) {
     const fs::path root = shared / "data" / "human_seg";
     const cv::Mat bgr = cv::imread((root / "images" / (std::to_string(id) + ".jpg")).string());
-    cv::Mat gt = cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(),
-                            cv::IMREAD_GRAYSCALE);
+    cv::Mat gt =
+        cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(), cv::IMREAD_GRAYSCALE);
     if (bgr.empty() || gt.empty()) throw pspslam::Error("human_seg sample " + std::to_string(id));
     if (gt.size() != bgr.size()) cv::resize(gt, gt, bgr.size(), 0, 0, cv::INTER_NEAREST);
     const cv::Mat pred = segmenter.segment(bgr) == 15;
@@ -143,8 +143,8 @@ int main(int argc, char** argv) {
     for (const fs::path& m : options.models) {
       auto meta = pspslam::load_segmenter_metadata(m);
       const std::string name = meta.name + "/" + std::to_string(meta.input_width) + "x" +
-                               std::to_string(meta.input_height) + "/threads:" +
-                               std::to_string(options.threads);
+                               std::to_string(meta.input_height) +
+                               "/threads:" + std::to_string(options.threads);
       benchmark::RegisterBenchmark(
           name.c_str(),
           [meta, &frames](benchmark::State& state) {
@@ -155,9 +155,9 @@ int main(int argc, char** argv) {
             for (auto _ : state) {
               const auto t0 = std::chrono::steady_clock::now();
               benchmark::DoNotOptimize(segmenter.segment(frames[i++ % frames.size()]));
-              ms.push_back(std::chrono::duration<double, std::milli>(
-                               std::chrono::steady_clock::now() - t0)
-                               .count());
+              ms.push_back(
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                      .count());
             }
             state.counters["median_ms"] = median(ms);
             state.counters["frames"] = static_cast<double>(ms.size());

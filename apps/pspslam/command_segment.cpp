@@ -68,7 +68,8 @@ int segment_command(const std::vector<std::string>& args) {
   if (limit < 0) throw Error("segment: flag --limit must be >= 0, got " + parser.get("limit"));
   if (start < 0) throw Error("segment: flag --start must be >= 0, got " + parser.get("start"));
   if (step < 1) throw Error("segment: flag --step must be >= 1, got " + parser.get("step"));
-  if (threads < 1) throw Error("segment: flag --threads must be >= 1, got " + parser.get("threads"));
+  if (threads < 1)
+    throw Error("segment: flag --threads must be >= 1, got " + parser.get("threads"));
   if (dilation < 0) {
     throw Error("segment: flag --dilation must be >= 0, got " + parser.get("dilation"));
   }
@@ -98,10 +99,10 @@ int segment_command(const std::vector<std::string>& args) {
     times.push_back(ms);
     const cv::Mat mask = dynamic_mask(labels, dynamic_ids, dilation);
     const std::string stem = chosen[i].stem().string();
-    const bool ok = cv::imwrite((out / (stem + "_overlay.png")).string(),
-                                overlay_labels(bgr, labels)) &&
-                    cv::imwrite((out / (stem + "_labels.png")).string(), labels) &&
-                    cv::imwrite((out / (stem + "_mask.png")).string(), mask);
+    const bool ok =
+        cv::imwrite((out / (stem + "_overlay.png")).string(), overlay_labels(bgr, labels)) &&
+        cv::imwrite((out / (stem + "_labels.png")).string(), labels) &&
+        cv::imwrite((out / (stem + "_mask.png")).string(), mask);
     if (!ok) throw Error("segment: cannot write images into '" + out.string() + "'");
     const double dynamic_share = cv::countNonZero(mask) * 100.0 / static_cast<double>(mask.total());
     std::cout << stem << "  " << std::fixed << std::setprecision(1) << ms << " ms  dynamic "
@@ -113,8 +114,7 @@ int segment_command(const std::vector<std::string>& args) {
   std::cout << std::fixed << std::setprecision(1) << "model " << meta.name << " input "
             << meta.input_width << "x" << meta.input_height << ", " << threads
             << " threads: median " << median(steady) << " ms over " << steady.size()
-            << " images (first " << times.front() << " ms), outputs in " << out.string()
-            << "\n";
+            << " images (first " << times.front() << " ms), outputs in " << out.string() << "\n";
   return 0;
 }
 

@@ -97,9 +97,8 @@ TEST(AntColonySearch, FindsEveryPlantedClusterTestingFewerPoints) {
       EXPECT_EQ(r.dynamic_count, found);
 
       DynamicPointSearch exhaustive(AntColonyParams{.strategy = SearchStrategy::exhaustive});
-      const SearchResult& all = exhaustive.run(set.points, kImage, [&](int i) {
-        return set.cluster[i] >= 0;
-      });
+      const SearchResult& all =
+          exhaustive.run(set.points, kImage, [&](int i) { return set.cluster[i] >= 0; });
       EXPECT_EQ(all.tested_count, static_cast<int>(set.points.size()));
       EXPECT_EQ(all.dynamic_count, planted);
     }

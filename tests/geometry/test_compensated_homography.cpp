@@ -12,7 +12,7 @@ namespace {
 
 Eigen::Matrix3d true_homography() {
   Eigen::Matrix3d H;
-  H << 1.02, 0.03, 6.5,  //
+  H << 1.02, 0.03, 6.5,   //
       -0.02, 0.99, -4.0,  //
       2e-5, -1e-5, 1.0;
   return H;
@@ -108,7 +108,8 @@ TEST(CompensatedHomography, TooFewOrMismatchedPoints) {
                                     std::span<const Eigen::Vector2d>(four), HomographyParams{});
     FAIL() << "expected Error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "estimate_compensated_homography: 3 previous points but 4 current points");
+    EXPECT_STREQ(e.what(),
+                 "estimate_compensated_homography: 3 previous points but 4 current points");
   }
 }
 
@@ -136,7 +137,8 @@ TEST(CompensatedHomography, CvPointOverloadAndWarp) {
     }
   // The centre of the person box moves where the homography sends it.
   const Eigen::Vector2d centre = transfer_point(true_homography(), Eigen::Vector2d(250, 190));
-  EXPECT_EQ(warped.at<std::uint8_t>(static_cast<int>(centre.y()), static_cast<int>(centre.x())), 15);
+  EXPECT_EQ(warped.at<std::uint8_t>(static_cast<int>(centre.y()), static_cast<int>(centre.x())),
+            15);
   std::vector<Eigen::Vector2d> projected;
   transfer_points(h.H, std::span<const Eigen::Vector2d>(c.previous), projected);
   ASSERT_EQ(projected.size(), c.previous.size());

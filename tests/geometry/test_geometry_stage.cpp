@@ -8,7 +8,6 @@
 namespace pspslam {
 namespace {
 
-
 struct Rendered {
   cv::Mat depth, labels;
 };
@@ -80,8 +79,9 @@ TEST(GeometryStage, FuseMasksIsDilatedOr) {
     fuse_dynamic_masks(semantic, cv::Mat::zeros(50, 50, CV_8UC1), 0);
     FAIL() << "expected Error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(),
-                 "fuse_dynamic_masks: semantic mask 100x100 and geometry mask 50x50 differ in size");
+    EXPECT_STREQ(
+        e.what(),
+        "fuse_dynamic_masks: semantic mask 100x100 and geometry mask 50x50 differ in size");
   }
 }
 

@@ -25,7 +25,8 @@ Pose translated(double x) {
 
 // Two-view scene: a wall 3 m in front of both cameras; the reference is 10 cm to the left.
 struct TwoViewScene {
-  std::vector<DepthView> references{{translated(-0.1), cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f))}};
+  std::vector<DepthView> references{
+      {translated(-0.1), cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f))}};
   Pose T_world_current = Pose::Identity();
 };
 
@@ -109,8 +110,8 @@ TEST(MultiViewTest, VoteFraction) {
 }
 
 TEST(MultiViewTest, ParamsFromYamlNameTheKey) {
-  const YAML::Node node =
-      YAML::Load("depth_threshold_relative: 0.05\ndisagreement: either_sign\nmax_parallax_deg: 25\n");
+  const YAML::Node node = YAML::Load(
+      "depth_threshold_relative: 0.05\ndisagreement: either_sign\nmax_parallax_deg: 25\n");
   YamlSection section(node, "g.yaml", "geometry.multiview");
   const MultiViewParams p = MultiViewParams::from_yaml(section);
   EXPECT_DOUBLE_EQ(p.depth_threshold_relative, 0.05);
@@ -132,7 +133,8 @@ TEST(MultiViewTest, ParamsFromYamlNameTheKey) {
     MultiViewParams::from_yaml(type_section);
     FAIL() << "expected Error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "g.yaml:1: key 'geometry.multiview.max_parallax_deg' has an invalid value");
+    EXPECT_STREQ(e.what(),
+                 "g.yaml:1: key 'geometry.multiview.max_parallax_deg' has an invalid value");
   }
 }
 

@@ -36,7 +36,8 @@ int SyntheticWorld::add_transient_point(const Eigen::Vector3d& position,
 std::shared_ptr<KeyFrame> SyntheticWorld::make_keyframe(std::uint64_t id,
                                                         const Pose& T_camera_world_true,
                                                         const Pose& estimated_T_camera_world,
-                                                        const Map& map) {
+                                                        const Map& map,
+                                                        double wrong_association_fraction) {
   const PinholeCamera& pinhole = camera_->pinhole;
   cv::Mat depth(pinhole.height, pinhole.width, CV_32F, cv::Scalar(0.0f));
   cv::Mat occupied(pinhole.height, pinhole.width, CV_8U, cv::Scalar(0));
@@ -78,9 +79,17 @@ std::shared_ptr<KeyFrame> SyntheticWorld::make_keyframe(std::uint64_t id,
     const int w = world_index(*point);
     if (w >= 0) by_world.emplace(w, point);
   }
+  std::vector<std::shared_ptr<MapPoint>> all_points;
+  for (const auto& [w, point] : by_world) all_points.push_back(point);
+  std::bernoulli_distribution wrong(wrong_association_fraction);
   for (size_t k = 0; k < keypoint_world.size(); ++k) {
     const auto found = by_world.find(keypoint_world[k]);
-    if (found != by_world.end()) frame.map_points[k] = found->second;
+    if (found == by_world.end()) continue;
+    frame.map_points[k] = found->second;
+    if (wrong(rng_)) {
+      std::uniform_int_distribution<size_t> any(0, all_points.size() - 1);
+      frame.map_points[k] = all_points[any(rng_)];
+    }
   }
   keypoint_world_index_[id] = keypoint_world;
   return std::make_shared<KeyFrame>(id, frame);

@@ -39,8 +39,11 @@ class SyntheticWorld {
   // Builds keyframe `id` seen from T_camera_world_true (1 px pixel noise at level 0, exact depth
   // on the point's pixel), gives it `estimated_T_camera_world`, and associates every keypoint
   // whose world point already has a map point in `map` (as tracking would after matching).
+  // A fraction of those associations can be made wrong (another, random map point), as bad
+  // matches are.
   std::shared_ptr<KeyFrame> make_keyframe(std::uint64_t id, const Pose& T_camera_world_true,
-                                          const Pose& estimated_T_camera_world, const Map& map);
+                                          const Pose& estimated_T_camera_world, const Map& map,
+                                          double wrong_association_fraction = 0.0);
 
   // World point index behind keypoint `index` of keyframe `keyframe_id` (-1: none).
   int world_index(std::uint64_t keyframe_id, int index) const;

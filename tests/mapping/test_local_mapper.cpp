@@ -112,7 +112,6 @@ TEST(LocalMapper, BuildsCullsAndOptimisesASyntheticMap) {
     ++compared;
   }
   ASSERT_GT(compared, 0);
-  printf("DIAG depth %lu tri %lu culled %lu fused %lu kfculled %lu ba %lu int %lu out %lu last_ba %.3f last_kf %.3f err %.4f -> %.4f median tri err %.4f pts %zu kfs %zu\n", run.stats.points_from_depth, run.stats.points_triangulated, run.stats.points_culled, run.stats.points_fused, run.stats.keyframes_culled, run.stats.bundle_adjustments, run.stats.bundle_adjustments_interrupted, run.stats.ba_outliers_removed, run.stats.last_bundle_adjustment_seconds, run.stats.last_keyframe_seconds, error_before / compared, error_after / compared, errors[errors.size() / 2], run.map->num_map_points(), run.map->num_keyframes());
   EXPECT_LT(error_after, 0.3 * error_before)
       << "mean centre error " << error_before / compared << " -> " << error_after / compared;
   EXPECT_LT(error_after / compared, 0.01);
@@ -161,6 +160,34 @@ TEST(LocalMapper, FirstKeyframeCreatesPointsFromDepthOnly) {
     EXPECT_TRUE(world.points()[w].has_depth);
     EXPECT_LT((point->position() - world.points()[w].position).norm(), 0.01);
   }
+}
+
+TEST(LocalMapper, BundleAdjustmentRemovesWrongAssociations) {
+  SyntheticWorld world(700, 0.2, 24);
+  auto map = std::make_shared<Map>();
+  LocalMapper mapper(map, LocalMappingOptions{});
+  const int num_keyframes = 5;
+  for (int k = 0; k < num_keyframes; ++k) {
+    const Pose pose = testing::path_pose(k);
+    // From the third keyframe on, 5% of tracking's matches point at the wrong map point.
+    mapper.process(world.make_keyframe(k, pose, pose, *map, k >= 2 ? 0.05 : 0.0));
+  }
+  EXPECT_GT(mapper.stats().ba_outliers_removed, 5u);
+  expect_consistent(*map);
+  // What survives is right: each observation's keypoint shows the point's own world point.
+  int wrong = 0, total = 0;
+  for (const auto& keyframe : map->keyframes()) {
+    const auto points = keyframe->map_points();
+    for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+      if (!points[i]) continue;
+      ++total;
+      // A wrong match that the map then adopted may name either world point; count mismatches
+      // against the point's first observation.
+      wrong += world.world_index(keyframe->id(), i) != world.world_index(*points[i]);
+    }
+  }
+  EXPECT_GT(total, 1000);
+  EXPECT_LT(wrong, total / 200) << wrong << " wrong of " << total;
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <map>
 #include <thread>
 
@@ -57,10 +58,10 @@ TEST(KeyFrameDatabase, RejectsWordsOutsideTheVocabulary) {
 
 TEST(KeyFrameDatabase, CommonWordThresholdScoresAndExclusion) {
   KeyFrameDatabase db(100);
-  db.add(10, bow_of({1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));       // shares 10 with the query
-  db.add(11, bow_of({1, 2, 3, 4, 5, 6, 7, 8, 50, 51}));      // shares 8 = 0.8 * 10: kept
-  db.add(12, bow_of({1, 2, 3, 4, 5, 6, 7, 60, 61, 62}));     // shares 7 < 8: dropped
-  db.add(13, bow_of({70, 71}));                              // shares nothing
+  db.add(10, bow_of({1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));    // shares 10 with the query
+  db.add(11, bow_of({1, 2, 3, 4, 5, 6, 7, 8, 50, 51}));   // shares 8 = 0.8 * 10: kept
+  db.add(12, bow_of({1, 2, 3, 4, 5, 6, 7, 60, 61, 62}));  // shares 7 < 8: dropped
+  db.add(13, bow_of({70, 71}));                           // shares nothing
   const BowVector query = bow_of({1, 2, 3, 4, 5, 6, 7, 8, 9, 10});
 
   // Without covisibility every keyframe is its own group; groups >= 0.75 * best are returned.
@@ -143,19 +144,31 @@ TEST(KeyFrameDatabase, ErasedKeyframesAreNeverReturned) {
 
 TEST(KeyFrameDatabase, ConcurrentAddEraseAndQuery) {
   KeyFrameDatabase db(64);
+  // Keyframes that stay, one per word, so every query has an answer however threads interleave.
+  for (WordId w = 0; w < 64; ++w) db.add(100000 + w, bow_of({w}));
+  std::atomic<bool> writing{true};
   std::thread writer([&] {
     for (KeyFrameId id = 0; id < 2000; ++id) {
       db.add(id, bow_of({static_cast<WordId>(id % 64), static_cast<WordId>((id + 1) % 64)}));
       if (id >= 10) db.erase(id - 10);
     }
+    writing = false;
   });
-  std::size_t answers = 0;
-  for (int i = 0; i < 2000; ++i) {
-    answers += db.query(bow_of({static_cast<WordId>(i % 64)}), nullptr).size();
+  std::size_t queries = 0;
+  std::size_t unanswered = 0;
+  while (writing || queries < 1000) {
+    const WordId w = static_cast<WordId>(queries % 64);
+    const std::vector<PlaceCandidate> result = db.query(bow_of({w}), nullptr);
+    if (result.empty()) ++unanswered;
+    for (const PlaceCandidate& c : result) {
+      // Only keyframes holding the word: a fixed one, or one the writer added and not yet erased.
+      EXPECT_TRUE(c.id == 100000 + w || c.id % 64 == w || (c.id + 1) % 64 == w) << c.id;
+    }
+    ++queries;
   }
   writer.join();
-  EXPECT_EQ(db.size(), 10u);
-  EXPECT_GT(answers, 0u);
+  EXPECT_EQ(unanswered, 0u);
+  EXPECT_EQ(db.size(), 64u + 10u);
 }
 
 }  // namespace

@@ -9,12 +9,12 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "place_test_data.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/place/keyframe_database.h"
 #include "pspslam/place/vocabulary.h"
 #include "pspslam/synth/scene.h"
-#include "place_test_data.h"
 
 namespace pspslam {
 namespace {
@@ -63,7 +63,8 @@ class LoopPlaceRecognition : public ::testing::Test {
     std::vector<KeyFrameId> out;
     for (const long offset : {-10L, 10L, -20L, 20L}) {
       const long n = static_cast<long>(id) + offset;
-      if (n >= 0 && n <= static_cast<long>(kLastKeyframe)) out.push_back(static_cast<KeyFrameId>(n));
+      if (n >= 0 && n <= static_cast<long>(kLastKeyframe))
+        out.push_back(static_cast<KeyFrameId>(n));
     }
     return out;
   }
@@ -129,8 +130,7 @@ TEST_F(LoopPlaceRecognition, ErasedKeyframeIsNeverReturned) {
   ASSERT_FALSE(candidates.empty());
   for (const PlaceCandidate& c : candidates) EXPECT_NE(c.id, 10u);
   // The neighbours of the erased keyframe take its place.
-  EXPECT_TRUE(candidates.front().id == 0u || candidates.front().id == 20u)
-      << candidates.front().id;
+  EXPECT_TRUE(candidates.front().id == 0u || candidates.front().id == 20u) << candidates.front().id;
 }
 
 }  // namespace

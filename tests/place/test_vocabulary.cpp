@@ -5,10 +5,10 @@
 #include <random>
 #include <set>
 
+#include "place_test_data.h"
 #include "pspslam/core/error.h"
 #include "pspslam/feature/hamming.h"
 #include "pspslam/place/vocabulary.h"
-#include "place_test_data.h"
 
 namespace pspslam {
 namespace {
@@ -123,7 +123,8 @@ TEST(VocabularyTraining, TwoLevelsSeparateClustersOfClusters) {
   std::set<WordId> used;
   for (int cluster = 0; cluster < 16; ++cluster) {
     std::set<WordId> words;
-    for (int i = 0; i < 100; ++i) words.insert(vocabulary.word(data.ptr<std::uint8_t>(cluster * 100 + i)));
+    for (int i = 0; i < 100; ++i)
+      words.insert(vocabulary.word(data.ptr<std::uint8_t>(cluster * 100 + i)));
     ASSERT_EQ(words.size(), 1u) << "sub-cluster " << cluster;
     used.insert(*words.begin());
     EXPECT_EQ(hamming_distance(vocabulary.node_descriptor(vocabulary.word_node(*words.begin())),
@@ -143,8 +144,10 @@ TEST(VocabularyTraining, LookupMatchesBruteForceDescentAndIsDeterministic) {
   params.branching = 6;
   params.levels = 4;
   params.seed = 42;
-  const Vocabulary a = Vocabulary::train(planted.descriptors, split_images(planted.descriptors, 20), params);
-  const Vocabulary b = Vocabulary::train(planted.descriptors, split_images(planted.descriptors, 20), params);
+  const Vocabulary a =
+      Vocabulary::train(planted.descriptors, split_images(planted.descriptors, 20), params);
+  const Vocabulary b =
+      Vocabulary::train(planted.descriptors, split_images(planted.descriptors, 20), params);
   ASSERT_EQ(a.node_count(), b.node_count());
   for (NodeId n = 0; n < a.node_count(); ++n) {
     ASSERT_EQ(std::memcmp(a.node_descriptor(n), b.node_descriptor(n), 32), 0) << "node " << n;

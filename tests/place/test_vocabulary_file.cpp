@@ -7,9 +7,9 @@
 #include <random>
 #include <string>
 
+#include "place_test_data.h"
 #include "pspslam/core/error.h"
 #include "pspslam/place/vocabulary.h"
-#include "place_test_data.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -124,15 +124,15 @@ TEST_F(VocabularyFile, WrongVersion) {
 
 TEST_F(VocabularyFile, TruncatedHeaderAndPayload) {
   write_bytes(file_, bytes_.substr(0, 20));
-  EXPECT_EQ(load_error(file_),
-            prefix() + "truncated (the header needs 48 bytes, the file has 20)");
+  EXPECT_EQ(load_error(file_), prefix() + "truncated (the header needs 48 bytes, the file has 20)");
   write_bytes(file_, bytes_.substr(0, bytes_.size() - 100));
-  EXPECT_EQ(load_error(file_), prefix() + "truncated (expected " +
-                                   std::to_string(bytes_.size()) + " bytes, the file has " +
-                                   std::to_string(bytes_.size() - 100) + ")");
+  EXPECT_EQ(load_error(file_), prefix() + "truncated (expected " + std::to_string(bytes_.size()) +
+                                   " bytes, the file has " + std::to_string(bytes_.size() - 100) +
+                                   ")");
   write_bytes(file_, bytes_ + "xyz");
-  EXPECT_EQ(load_error(file_), prefix() + "unexpected 3 trailing bytes after the payload "
-                                          "(expected " +
+  EXPECT_EQ(load_error(file_), prefix() +
+                                   "unexpected 3 trailing bytes after the payload "
+                                   "(expected " +
                                    std::to_string(bytes_.size()) + " bytes)");
 }
 
@@ -143,9 +143,10 @@ TEST_F(VocabularyFile, CorruptPayloadFailsChecksum) {
   const std::string message = load_error(file_);
   EXPECT_EQ(message.rfind(prefix() + "checksum mismatch (stored 0x", 0), 0u) << message;
   EXPECT_TRUE(message.ends_with("): the file is corrupt")) << message;
-  EXPECT_EQ(message.size(), prefix().size() + std::string("checksum mismatch (stored 0x, "
-                                                          "computed 0x): the file is corrupt")
-                                                  .size() +
+  EXPECT_EQ(message.size(), prefix().size() +
+                                std::string("checksum mismatch (stored 0x, "
+                                            "computed 0x): the file is corrupt")
+                                    .size() +
                                 32)
       << message;
 }

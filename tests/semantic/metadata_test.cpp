@@ -75,7 +75,8 @@ TEST(SegmenterMetadata, MissingKeyIsNamed) {
 
 TEST(SegmenterMetadata, UnknownKeyIsNamedWithItsLine) {
   const auto dir = testing::make_temp_dir("semantic");
-  const auto file = write_yaml(dir, replace(kValid, "  layout: NCHW\n", "  layout: NCHW\n  scale: 2\n"));
+  const auto file =
+      write_yaml(dir, replace(kValid, "  layout: NCHW\n", "  layout: NCHW\n  scale: 2\n"));
   EXPECT_EQ(error_of(file), file.string() + ":8: unknown key 'input.scale'");
   const auto file2 = write_yaml(dir, std::string(kValid) + "licence: MIT\n");
   EXPECT_EQ(error_of(file2), file2.string() + ":14: unknown key 'licence'");

@@ -25,8 +25,8 @@ std::vector<int> validation_ids() {
 double person_iou(Segmenter& segmenter, const std::filesystem::path& shared, int id) {
   const auto root = shared / "data" / "human_seg";
   const cv::Mat bgr = cv::imread((root / "images" / (std::to_string(id) + ".jpg")).string());
-  cv::Mat gt = cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(),
-                          cv::IMREAD_GRAYSCALE);
+  cv::Mat gt =
+      cv::imread((root / "masks" / (std::to_string(id) + ".png")).string(), cv::IMREAD_GRAYSCALE);
   EXPECT_FALSE(bgr.empty() || gt.empty()) << "human_seg sample " << id;
   if (gt.size() != bgr.size()) cv::resize(gt, gt, bgr.size(), 0, 0, cv::INTER_NEAREST);
   const cv::Mat pred = segmenter.segment(bgr) == 15;
@@ -96,8 +96,9 @@ TEST(OnnxSegmenter, PersonIoUOnValidationPhotos) {
   double sum = 0;
   const int n = 12;
   for (int i = 0; i < n; ++i) sum += person_iou(segmenter, shared, ids[static_cast<size_t>(i)]);
-  // Measured on these 12 photos at export time: see models/pspnet/MODEL_CARD.md.
-  EXPECT_GE(sum / n, 0.80);
+  // The shipped model scores 0.854 on these 12 photos (0.760 on all 46, MODEL_CARD.md); the
+  // margin only absorbs arg-max ties, a broken pre-processing drops far below it.
+  EXPECT_GE(sum / n, 0.82);
 }
 
 TEST(OnnxSegmenter, TeachersRunThroughTheSameClass) {

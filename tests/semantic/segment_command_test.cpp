@@ -16,10 +16,10 @@ TEST(SegmentCommand, WritesOverlaysMasksAndTiming) {
   std::filesystem::copy_file(golden, images / "a.png");
   std::filesystem::copy_file(golden, images / "b.png");
   std::string output;
-  const int status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " segment --images " +
-                                            images.string() + " --out " + (dir / "out").string() +
-                                            " --limit 1 --dilation 3",
-                                        &output);
+  const int status =
+      testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " segment --images " + images.string() +
+                             " --out " + (dir / "out").string() + " --limit 1 --dilation 3",
+                         &output);
   ASSERT_EQ(status, 0) << output;
   EXPECT_NE(output.find("median"), std::string::npos) << output;
   for (const char* name : {"a_overlay.png", "a_labels.png", "a_mask.png"}) {
@@ -27,8 +27,9 @@ TEST(SegmentCommand, WritesOverlaysMasksAndTiming) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "b_mask.png"));  // --limit 1
   const cv::Mat labels = cv::imread((dir / "out" / "a_labels.png").string(), cv::IMREAD_UNCHANGED);
-  const cv::Mat expected = cv::imread(
-      (source_dir() / "models" / "pspnet" / "golden" / "labels.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat expected =
+      cv::imread((source_dir() / "models" / "pspnet" / "golden" / "labels.png").string(),
+                 cv::IMREAD_UNCHANGED);
   ASSERT_EQ(labels.size(), expected.size());
   EXPECT_LE(cv::countNonZero(labels != expected), static_cast<int>(labels.total() / 1000));
 }
@@ -40,12 +41,12 @@ TEST(SegmentCommand, ReportsBadFlagsWithTheirName) {
                                       (dir / "nope").string() + " --out " + dir.string(),
                                   &output);
   EXPECT_EQ(status, 2);
-  EXPECT_NE(output.find("error: segment: --images '" + (dir / "nope").string() +
-                        "' is not a directory"),
-            std::string::npos)
+  EXPECT_NE(
+      output.find("error: segment: --images '" + (dir / "nope").string() + "' is not a directory"),
+      std::string::npos)
       << output;
-  status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " segment --images " +
-                                  dir.string() + " --out " + dir.string() + " --step 0",
+  status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " segment --images " + dir.string() +
+                                  " --out " + dir.string() + " --step 0",
                               &output);
   EXPECT_EQ(status, 2);
   EXPECT_NE(output.find("error: segment: flag --step must be >= 1, got 0"), std::string::npos)

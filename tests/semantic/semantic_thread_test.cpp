@@ -135,8 +135,9 @@ TEST(SemanticThread, KeepsOnlyTheLatestPendingFrame) {
 
   thread.submit(1, 1.0, frame_image(1));
   wait_entered(*control, 1);  // frame 1 is being segmented
-  for (std::int64_t id = 2; id <= 5; ++id) thread.submit(id, static_cast<double>(id), frame_image(id));
-  EXPECT_EQ(thread.stats().dropped, 3);  // 2, 3, 4 replaced by 5
+  for (std::int64_t id = 2; id <= 5; ++id)
+    thread.submit(id, static_cast<double>(id), frame_image(id));
+  EXPECT_EQ(thread.stats().dropped, 3);        // 2, 3, 4 replaced by 5
   EXPECT_EQ(thread.wait_for(3, 1s), nullptr);  // dropped: answered at once, not after 1 s
   open_gate(*control);
   wait_entered(*control, 2);
@@ -160,7 +161,8 @@ TEST(SemanticThread, QueueSizeBoundsThePendingFrames) {
   SemanticThread thread(std::make_unique<FakeSegmenter>(control, 0ms), params);
   thread.submit(1, 1.0, frame_image(1));
   wait_entered(*control, 1);
-  for (std::int64_t id = 2; id <= 6; ++id) thread.submit(id, static_cast<double>(id), frame_image(id));
+  for (std::int64_t id = 2; id <= 6; ++id)
+    thread.submit(id, static_cast<double>(id), frame_image(id));
   for (int i = 0; i < 3; ++i) {
     open_gate(*control);
     if (i < 2) wait_entered(*control, i + 2);
@@ -173,15 +175,15 @@ TEST(SemanticThread, QueueSizeBoundsThePendingFrames) {
 TEST(SemanticThread, ShutdownWithPendingWorkFinishesTheRunningFrameAndDropsTheRest) {
   auto control = std::make_shared<FakeSegmenter::Control>();
   control->gated = true;
-  auto thread =
-      std::make_unique<SemanticThread>(std::make_unique<FakeSegmenter>(control, 0ms), SemanticParams{});
+  auto thread = std::make_unique<SemanticThread>(std::make_unique<FakeSegmenter>(control, 0ms),
+                                                 SemanticParams{});
   thread->submit(1, 1.0, frame_image(1));
   wait_entered(*control, 1);
   thread->submit(2, 2.0, frame_image(2));
 
   auto stopping = std::async(std::launch::async, [&] { thread->stop(); });
   EXPECT_EQ(stopping.wait_for(100ms), std::future_status::timeout);  // frame 1 still running
-  EXPECT_FALSE(thread->submit(3, 3.0, frame_image(3)));               // no new work accepted
+  EXPECT_FALSE(thread->submit(3, 3.0, frame_image(3)));              // no new work accepted
   open_gate(*control);
   ASSERT_EQ(stopping.wait_for(5s), std::future_status::ready);
   EXPECT_EQ(control->seen, (std::vector<int>{1}));
@@ -198,7 +200,8 @@ TEST(SemanticThread, DestructorJoinsWhilePendingFramesWait) {
   auto control = std::make_shared<FakeSegmenter::Control>();
   {
     SemanticThread thread(std::make_unique<FakeSegmenter>(control, 30ms), SemanticParams{});
-    for (std::int64_t id = 1; id <= 5; ++id) thread.submit(id, static_cast<double>(id), frame_image(id));
+    for (std::int64_t id = 1; id <= 5; ++id)
+      thread.submit(id, static_cast<double>(id), frame_image(id));
   }  // must not hang nor crash
   std::lock_guard lock(control->mutex);
   EXPECT_LE(control->entered, 2);
@@ -237,10 +240,10 @@ TEST(DynamicMask, MarksDynamicLabelsAndGrowsByTheMargin) {
   EXPECT_EQ(m0.at<uchar>(12, 12), 255);
   EXPECT_EQ(m0.at<uchar>(21, 31), 0);
   const cv::Mat m2 = dynamic_mask(labels, {15}, 2);
-  EXPECT_EQ(m2.at<uchar>(12, 8), 255);   // 2 px left of the person
-  EXPECT_EQ(m2.at<uchar>(12, 7), 0);     // 3 px: outside the margin
+  EXPECT_EQ(m2.at<uchar>(12, 8), 255);  // 2 px left of the person
+  EXPECT_EQ(m2.at<uchar>(12, 7), 0);    // 3 px: outside the margin
   EXPECT_EQ(m2.at<uchar>(8, 12), 255);
-  EXPECT_EQ(m2.at<uchar>(31, 41), 0);    // dog not in this set
+  EXPECT_EQ(m2.at<uchar>(31, 41), 0);  // dog not in this set
 }
 
 }  // namespace

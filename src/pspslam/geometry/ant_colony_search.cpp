@@ -79,7 +79,8 @@ void DynamicPointSearch::build_path(cv::Size image_size) {
   bool left_to_right = true;
   for (float y = half_lane; y < image_size.height; y += params_.lane_spacing_px) {
     std::vector<float> xs;
-    for (float x = params_.node_spacing_px / 2.0f; x < image_size.width; x += params_.node_spacing_px)
+    for (float x = params_.node_spacing_px / 2.0f; x < image_size.width;
+         x += params_.node_spacing_px)
       xs.push_back(x);
     if (!left_to_right) std::reverse(xs.begin(), xs.end());
     for (float x : xs) path_nodes_.emplace_back(x, y);

@@ -55,7 +55,8 @@ Eigen::Vector2d apply(const Eigen::Matrix3d& T, const Eigen::Vector2d& p) {
 
 // Twice the signed area of a triangle; near zero means three of the four sample points are
 // collinear, for which the 4-point homography is undefined.
-double triangle_area2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+double triangle_area2(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      const Eigen::Vector2d& c) {
   return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
 }
 
@@ -101,7 +102,8 @@ double rms_over(const Eigen::Matrix3d& H, std::span<const Eigen::Vector2d> x,
 // Levenberg-Marquardt on eq. 11 in normalised coordinates. The previous points are normalised by
 // Tx and the current ones by Ty (a similarity), so the normalised residual is the pixel residual
 // times one constant: the minimiser is the same as for pixel errors, with a well-scaled system.
-int refine_levenberg_marquardt(std::span<const Eigen::Vector2d> x, std::span<const Eigen::Vector2d> y,
+int refine_levenberg_marquardt(std::span<const Eigen::Vector2d> x,
+                               std::span<const Eigen::Vector2d> y,
                                std::span<const std::uint8_t> use, int max_iterations,
                                Eigen::Matrix3d& H) {
   const Eigen::Matrix3d Tx = normalising_transform(x, use);
@@ -260,7 +262,8 @@ CompensatedHomography estimate_compensated_homography(std::span<const Eigen::Vec
       if (all_inlier_sample > 1.0 - 1e-12) {
         needed_iterations = iteration + 1;
       } else if (all_inlier_sample > 0.0) {
-        const double k = std::log(1.0 - params.ransac_confidence) / std::log(1.0 - all_inlier_sample);
+        const double k =
+            std::log(1.0 - params.ransac_confidence) / std::log(1.0 - all_inlier_sample);
         needed_iterations = std::min(params.max_ransac_iterations, static_cast<int>(std::ceil(k)));
       }
     }
@@ -270,14 +273,15 @@ CompensatedHomography estimate_compensated_homography(std::span<const Eigen::Vec
 
   std::vector<std::uint8_t> ransac_inliers(n, 0);
   for (size_t i = 0; i < n; ++i) {
-    ransac_inliers[i] = squared_transfer_error(result.H_ransac, previous[i], current[i]) < threshold2;
+    ransac_inliers[i] =
+        squared_transfer_error(result.H_ransac, previous[i], current[i]) < threshold2;
   }
   result.ransac_inlier_count = best_inliers;
 
   // Eq. 11: minimise the sum of squared transfer errors over the RANSAC inliers.
   result.H = result.H_ransac;
-  result.lm_iterations =
-      refine_levenberg_marquardt(previous, current, ransac_inliers, params.lm_max_iterations, result.H);
+  result.lm_iterations = refine_levenberg_marquardt(previous, current, ransac_inliers,
+                                                    params.lm_max_iterations, result.H);
   result.rms_before_px = rms_over(result.H_ransac, previous, current, ransac_inliers);
   result.rms_after_px = rms_over(result.H, previous, current, ransac_inliers);
   for (size_t i = 0; i < n; ++i) {

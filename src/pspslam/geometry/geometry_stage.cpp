@@ -22,7 +22,8 @@ struct Stopwatch {
     return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
   }
   double wall_ms() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall)
+        .count();
   }
   double cpu_ms() const { return thread_cpu_ms() - cpu; }
 };
@@ -156,7 +157,8 @@ cv::Mat fuse_dynamic_masks(const cv::Mat& semantic_mask, const cv::Mat& geometry
                            int dilation_px) {
   if (semantic_mask.empty() && geometry_mask.empty()) return {};
   const cv::Size size = semantic_mask.empty() ? geometry_mask.size() : semantic_mask.size();
-  if (!semantic_mask.empty() && !geometry_mask.empty() && semantic_mask.size() != geometry_mask.size()) {
+  if (!semantic_mask.empty() && !geometry_mask.empty() &&
+      semantic_mask.size() != geometry_mask.size()) {
     throw Error("fuse_dynamic_masks: semantic mask " + std::to_string(semantic_mask.cols) + "x" +
                 std::to_string(semantic_mask.rows) + " and geometry mask " +
                 std::to_string(geometry_mask.cols) + "x" + std::to_string(geometry_mask.rows) +

@@ -37,8 +37,8 @@ struct GeometryParams {
 // One frame's input. Spans and cv::Mat headers refer to caller-owned data for the duration of
 // GeometryStage::process() only.
 struct GeometryFrameInput {
-  cv::Mat depth;                         // current depth, CV_32FC1 metres
-  Pose T_world_camera = Pose::Identity();  // current pose estimate
+  cv::Mat depth;                               // current depth, CV_32FC1 metres
+  Pose T_world_camera = Pose::Identity();      // current pose estimate
   std::span<const Eigen::Vector2d> keypoints;  // candidate pixels (undistorted)
   // Measured depth per keypoint (metres); empty = read from `depth` at the rounded pixel.
   std::span<const float> keypoint_depths;

@@ -61,7 +61,8 @@ MultiViewTest::MultiViewTest(PinholeCamera camera, MultiViewParams params)
 
 void MultiViewTest::set_frame(const Pose& T_world_current, std::span<const DepthView> references) {
   references_.clear();
-  const size_t count = std::min(references.size(), static_cast<size_t>(params_.max_reference_views));
+  const size_t count =
+      std::min(references.size(), static_cast<size_t>(params_.max_reference_views));
   for (size_t i = 0; i < count; ++i) {
     const DepthView& view = references[i];
     if (view.depth.empty()) continue;
@@ -130,8 +131,8 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
   }
   if (verdict.valid_references > 0) {
     const int needed = std::max(
-        1, static_cast<int>(std::ceil(params_.min_dynamic_vote_fraction * verdict.valid_references -
-                                      1e-9)));
+        1, static_cast<int>(
+               std::ceil(params_.min_dynamic_vote_fraction * verdict.valid_references - 1e-9)));
     verdict.dynamic = verdict.dynamic_votes >= needed;
   }
   return verdict;

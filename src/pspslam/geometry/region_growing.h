@@ -58,8 +58,8 @@ class DynamicRegionGrower {
 
  private:
   RegionGrowParams params_;
-  cv::Mat grid_depth_;            // CV_32F, one sample per block
-  std::vector<int> region_of_;    // -1 = not visited; otherwise seed region id
+  cv::Mat grid_depth_;             // CV_32F, one sample per block
+  std::vector<int> region_of_;     // -1 = not visited; otherwise seed region id
   std::vector<int> region_seeds_;  // dynamic seeds that fell inside each region
   std::vector<std::uint8_t> barrier_;
   std::vector<int> queue_;

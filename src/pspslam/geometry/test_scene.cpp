@@ -51,8 +51,8 @@ GeometryTestScene::GeometryTestScene(GeometryTestSceneParams params) : params_(p
     boxes_.push_back({{x0, 0.35, depth}, {0.22, 0.85, 0.15}, 15, amplitude, omega, phase});
     if (params_.carried_object && p == 0) {
       // Held at the side at hand height, moving with the person.
-      boxes_.push_back({{x0 + 0.38, 0.3, depth - 0.1}, {0.15, 0.15, 0.15}, 100, amplitude, omega,
-                        phase});
+      boxes_.push_back(
+          {{x0 + 0.38, 0.3, depth - 0.1}, {0.15, 0.15, 0.15}, 100, amplitude, omega, phase});
     }
   }
 }

@@ -72,8 +72,8 @@ void LocalMapper::insert_keyframe_into_map(const std::shared_ptr<KeyFrame>& keyf
 
   const auto from_depth = create_points_from_depth(*map_, keyframe, options_);
   add_recent(from_depth);
+  // Seen by this keyframe alone, the new points add no covisibility edges yet.
   stats_.points_from_depth += from_depth.size();
-  if (!from_depth.empty()) keyframe->update_connections();
 }
 
 void LocalMapper::cull_recent_points(const KeyFrame& keyframe) {

@@ -35,9 +35,9 @@ struct PlaceQueryOptions {
 };
 
 struct PlaceCandidate {
-  KeyFrameId id = 0;           // best-scoring keyframe of its covisibility group
-  double score = 0.0;          // bow_score(query, id)
-  double group_score = 0.0;    // accumulated score of the group
+  KeyFrameId id = 0;         // best-scoring keyframe of its covisibility group
+  double score = 0.0;        // bow_score(query, id)
+  double group_score = 0.0;  // accumulated score of the group
   std::uint32_t common_words = 0;
 };
 

@@ -196,7 +196,8 @@ class BinaryKMeans {
     }
     for (int c = 0; c < k; ++c) {
       if (sizes_[c] == 0) continue;  // an empty cluster keeps its centre (dropped at the end)
-      const std::uint32_t* counts = &bit_counts_[static_cast<std::size_t>(c) * kDescriptorBytes * 8];
+      const std::uint32_t* counts =
+          &bit_counts_[static_cast<std::size_t>(c) * kDescriptorBytes * 8];
       std::uint8_t* center = &centers_[c * kDescriptorBytes];
       for (std::size_t byte = 0; byte < kDescriptorBytes; ++byte) {
         unsigned value = 0;
@@ -269,7 +270,8 @@ Vocabulary Vocabulary::train(const cv::Mat& tree_descriptors, const std::vector<
     throw Error("vocabulary: need at least k = " + std::to_string(params.branching) +
                 " training descriptors, got " + std::to_string(tree_descriptors.rows));
   }
-  const cv::Mat data = tree_descriptors.isContinuous() ? tree_descriptors : tree_descriptors.clone();
+  const cv::Mat data =
+      tree_descriptors.isContinuous() ? tree_descriptors : tree_descriptors.clone();
 
   TreeBuilder tree;
   const std::array<std::uint8_t, kDescriptorBytes> zero{};
@@ -351,8 +353,8 @@ Vocabulary Vocabulary::train(const cv::Mat& tree_descriptors, const std::vector<
   vocabulary.word_weight_.assign(vocabulary.word_count(), 0.0f);
   for (std::size_t w = 0; w < images_with_word.size(); ++w) {
     if (images_with_word[w] > 0) {
-      vocabulary.word_weight_[w] = static_cast<float>(
-          std::log(static_cast<double>(images.size()) / images_with_word[w]));
+      vocabulary.word_weight_[w] =
+          static_cast<float>(std::log(static_cast<double>(images.size()) / images_with_word[w]));
     }
   }
   return vocabulary;
@@ -539,8 +541,7 @@ Vocabulary Vocabulary::load(const std::filesystem::path& file) {
   if (!in) throw Error(prefix + "cannot open for reading");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 
-  if (bytes.size() >= kMagic.size() &&
-      !std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) {
+  if (bytes.size() >= kMagic.size() && !std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) {
     throw Error(prefix + "not a pspslam vocabulary (bad magic, expected \"PSPVOCAB\")");
   }
   if (bytes.size() < kHeaderBytes) {
@@ -571,9 +572,8 @@ Vocabulary Vocabulary::load(const std::filesystem::path& file) {
       static_cast<std::uint64_t>(words) * sizeof(float);
   if (payload_bytes != expected_payload) {
     throw Error(prefix + "invalid header (payload size " + std::to_string(payload_bytes) +
-                " does not match " + std::to_string(nodes) + " nodes and " +
-                std::to_string(words) + " words: expected " + std::to_string(expected_payload) +
-                ")");
+                " does not match " + std::to_string(nodes) + " nodes and " + std::to_string(words) +
+                " words: expected " + std::to_string(expected_payload) + ")");
   }
   const std::uint64_t expected_size = kHeaderBytes + payload_bytes;
   if (bytes.size() < expected_size) {

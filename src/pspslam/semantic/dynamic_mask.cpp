@@ -7,8 +7,7 @@
 
 namespace pspslam {
 
-cv::Mat dynamic_mask(const LabelMap& labels, const std::vector<int>& dynamic_ids,
-                     int dilation_px) {
+cv::Mat dynamic_mask(const LabelMap& labels, const std::vector<int>& dynamic_ids, int dilation_px) {
   if (labels.type() != CV_8UC1) throw Error("dynamic_mask: labels must be CV_8UC1");
   cv::Mat table(1, 256, CV_8U, cv::Scalar(0));
   for (int id : dynamic_ids) {

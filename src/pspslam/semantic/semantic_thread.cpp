@@ -35,7 +35,8 @@ void SemanticThread::stop() {
     if (stopping_ && !worker_.joinable()) return;
     stopping_ = true;
     stats_.dropped += static_cast<std::int64_t>(pending_.size());
-    if (!pending_.empty()) last_finished_id_ = std::max(last_finished_id_, pending_.back().frame_id);
+    if (!pending_.empty())
+      last_finished_id_ = std::max(last_finished_id_, pending_.back().frame_id);
     pending_.clear();
   }
   work_cv_.notify_all();

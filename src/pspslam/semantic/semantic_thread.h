@@ -93,7 +93,8 @@ class SemanticThread {
   std::deque<Pending> pending_;
   std::deque<std::shared_ptr<const SemanticResult>> history_;
   std::int64_t last_submitted_id_ = std::numeric_limits<std::int64_t>::min();
-  std::int64_t last_finished_id_ = std::numeric_limits<std::int64_t>::min();  // published or dropped
+  std::int64_t last_finished_id_ =
+      std::numeric_limits<std::int64_t>::min();  // published or dropped
   bool busy_ = false;
   bool stopping_ = false;
   SemanticStats stats_;

@@ -5,7 +5,11 @@
 //   keyframes.txt    keyframe poses at the end (after local mapping)
 //   trajectory_refined.txt  the frames of trajectory.txt re-expressed through their reference
 //                    keyframes after local BA (ORB-SLAM2's saved trajectory), written at the end
-//   timing.csv       per frame: extraction / tracking / local BA milliseconds, state
+//   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
+//                    dynamic-scene stages (mask age, geometry time, masked keypoints)
+//   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,
+//                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
+//                    written also when the run is interrupted (Ctrl-C / SIGTERM)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,6 +17,8 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -21,9 +27,11 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
 #include "pspslam/core/progress.h"
+#include "pspslam/core/shared_paths.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam::cli {
@@ -37,6 +45,59 @@ double median(std::vector<double> values) {
   const size_t mid = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + mid, values.end());
   return values[mid];
+}
+
+// {median, mean, p95} of one module's per-frame milliseconds.
+struct TimingSummary {
+  double median = 0.0;
+  double mean = 0.0;
+  double p95 = 0.0;
+  size_t count = 0;
+};
+
+TimingSummary summarize(std::vector<double> values) {
+  TimingSummary summary;
+  summary.count = values.size();
+  if (values.empty()) return summary;
+  std::sort(values.begin(), values.end());
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  summary.mean = sum / static_cast<double>(values.size());
+  summary.median = values[values.size() / 2];
+  summary.p95 = values[std::min(values.size() - 1,
+                                static_cast<size_t>(0.95 * static_cast<double>(values.size())))];
+  return summary;
+}
+
+std::string json_timing(const TimingSummary& t) {
+  char text[160];
+  std::snprintf(text, sizeof(text), "{\"median\": %.3f, \"mean\": %.3f, \"p95\": %.3f, \"count\": %zu}",
+                t.median, t.mean, t.p95, t.count);
+  return text;
+}
+
+// Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
+// with a warning that says which model is missing and how to get it; an explicitly requested
+// semantic mode with a missing model is an error.
+DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::path& model,
+                        bool explicit_model) {
+  const bool automatic = flag_value == "auto";
+  const DynamicMode wanted =
+      automatic ? DynamicMode::full : parse_dynamic_mode(flag_value, "--dynamic");
+  if (!uses_semantics(wanted)) return wanted;
+  try {
+    load_segmenter_metadata(model);
+    return wanted;
+  } catch (const Error& e) {
+    const std::string how =
+        "segmentation model not usable: " + std::string(e.what()) +
+        "\n  get it: train/export our PSPNet with tools/pspnet (models/pspnet/pspnet.yaml + "
+        ".onnx),\n  or pass a teacher, e.g. --model models/teachers/deeplabv3_mnv2_pascal.yaml "
+        "(ONNX in ../shared/models)";
+    if (!automatic || explicit_model) throw Error("--dynamic " + flag_value + ": " + how);
+    std::cerr << "warning: " << how << "\n  falling back to --dynamic geometry\n";
+    return DynamicMode::geometry;
+  }
 }
 
 std::ofstream open_output(const std::filesystem::path& file) {
@@ -61,6 +122,18 @@ int run_command(const std::vector<std::string>& args) {
   parser.add_option("max-frames", "process at most this many frames (0 = all)", "0");
   parser.add_switch("no-local-mapping",
                     "track only: keyframes enter the map but are never refined (debugging)");
+  parser.add_option("dynamic",
+                    "dynamic-scene mode: off | semantic | geometry | full | exhaustive | auto "
+                    "(auto = full when the segmentation model loads, else geometry)",
+                    "auto");
+  parser.add_option("model", "segmentation metadata YAML (relative: to the source directory)",
+                    "models/pspnet/pspnet.yaml");
+  parser.add_switch("realtime",
+                    "feed frames at the sequence's rate (late frames are dropped) and never wait "
+                    "for segmentation: use the newest mask, warped into the frame");
+  parser.add_option("mask-margin", "dilation of the semantic dynamic mask (pixels)", "5");
+  parser.add_option("cull-hits",
+                    "erase a map point after it lay on dynamic pixels in this many frames", "3");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
   if (max_frames_flag < 0)
@@ -83,32 +156,81 @@ int run_command(const std::vector<std::string>& args) {
   lost << "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
   std::ofstream timing = open_output(out_dir / "timing.csv");
   timing << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
-            "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms\n";
+            "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_ms,"
+            "mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points\n";
   std::cout << describe_sequence(setup);
 
   SystemOptions system_options;
   system_options.local_mapping = !parser.flag("no-local-mapping");
+  DynamicOptions& dynamic = system_options.dynamic;
+  dynamic.model = parser.get("model");
+  if (dynamic.model.is_relative()) dynamic.model = source_dir() / dynamic.model;
+  dynamic.mode = choose_mode(parser.get("dynamic"), dynamic.model, parser.has("model"));
+  dynamic.realtime = parser.flag("realtime");
+  dynamic.semantic.mask_dilation_px = parser.get_int("mask-margin");
+  if (dynamic.semantic.mask_dilation_px < 0)
+    throw Error("--mask-margin must be >= 0, got " + parser.get("mask-margin"));
+  dynamic.culling.min_dynamic_hits = parser.get_int("cull-hits");
+  if (dynamic.culling.min_dynamic_hits < 1)
+    throw Error("--cull-hits must be >= 1, got " + parser.get("cull-hits"));
+  std::cout << "dynamic:      " << to_string(dynamic.mode)
+            << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
+            << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
+            << "\n";
   System system(setup.config, system_options);
   InterruptGuard interrupt_guard;
   ProgressBar progress("slam", frames, std::cerr);
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;
   std::vector<double> tracking_cpu_ms;
+  std::vector<double> semantic_ms;  // inference time of each mask used (once per mask)
+  std::vector<double> semantic_wait_ms;
+  std::vector<double> geometry_ms;
+  std::vector<double> geometry_search_ms;
+  std::vector<double> flow_ms;
+  std::vector<double> local_mapping_ms;  // one entry per local BA
+  std::vector<double> mask_age_frames;
+  std::vector<double> mask_latency_ms;
+  size_t tested_points = 0, dynamic_points = 0, masked_keypoints = 0, culled_points = 0;
+  size_t frames_without_mask = 0, realtime_dropped = 0;
   Trajectory estimate;
   size_t processed = 0;
   size_t lost_count = 0;
   double ba_ms_before = 0.0;
+  double last_inference_ms = -1.0;
   const auto start = std::chrono::steady_clock::now();
+  // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
+  // network segments frame i+1 while frame i is tracked.
+  std::optional<RgbdFrame> next;
   for (size_t i = 0; i < frames; ++i) {
     if (interrupted()) break;
-    const RgbdFrame frame = sequence.load(i);
+    if (dynamic.realtime) {
+      // A live camera does not wait: skip to the newest frame whose time has come.
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const Timestamp t0 = sequence.timestamp(0);
+      size_t newest = i;
+      while (newest + 1 < frames && sequence.timestamp(newest + 1) - t0 <= elapsed) ++newest;
+      realtime_dropped += newest - i;
+      i = newest;
+      const double wait = sequence.timestamp(i) - t0 - elapsed;
+      if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+      next.reset();
+    }
+    const RgbdFrame frame = next ? std::move(*next) : sequence.load(i);
+    next.reset();
+    if (!dynamic.realtime && i + 1 < frames) {
+      next = sequence.load(i + 1);
+      if (i == 0) system.announce(frame);
+      system.announce(*next);
+    }
     if (frame.bgr.cols != camera.width || frame.bgr.rows != camera.height) {
       throw Error((sequence.directory() / sequence.files(i).rgb_file).string() + " is " +
                   std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
                   " but the config " + setup.config_file.string() + " says camera " +
                   std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
-    const FrameReport report = system.track(frame);
+    const FrameReport report = system.process(frame);
     const TrackResult& result = report.tracking;
     if (result.T_world_camera) {
       trajectory.write(frame.timestamp, *result.T_world_camera);
@@ -121,18 +243,46 @@ int run_command(const std::vector<std::string>& args) {
       lost << line << std::flush;
     }
     const MappingStats mapping = system.mapping_stats();
-    char row[256];
-    std::snprintf(row, sizeof(row), "%zu,%.6f,%s,%s,%d,%d,%d,%.3f,%.3f,%.3f,%zu,%.3f,%.3f\n", i,
-                  frame.timestamp, to_string(result.state), to_string(result.method),
+    const DynamicReport& dyn = report.dynamic;
+    char row[384];
+    std::snprintf(row, sizeof(row),
+                  "%zu,%.6f,%s,%s,%d,%d,%d,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%d,%d,%d,"
+                  "%d\n",
+                  i, frame.timestamp, to_string(result.state), to_string(result.method),
                   result.num_keypoints, result.num_inliers, result.keyframe_inserted ? 1 : 0,
                   report.extraction_ms, report.tracking_ms,
                   mapping.local_ba_ms_total - ba_ms_before, mapping.queued_keyframes,
-                  report.extraction_cpu_ms, report.tracking_cpu_ms);
+                  report.extraction_cpu_ms, report.tracking_cpu_ms, dyn.flow_ms,
+                  dyn.semantic_wait_ms, dyn.mask_age_frames, dyn.geometry_ms, dyn.tested_points,
+                  dyn.dynamic_points, dyn.masked_keypoints, dyn.culled_map_points);
     timing << row;
+    if (mapping.local_ba_ms_total > ba_ms_before)
+      local_mapping_ms.push_back(mapping.local_ba_ms_total - ba_ms_before);
     ba_ms_before = mapping.local_ba_ms_total;
     extraction_ms.push_back(report.extraction_ms);
     tracking_ms.push_back(report.tracking_ms);
     tracking_cpu_ms.push_back(report.tracking_cpu_ms);
+    if (dynamic.mode != DynamicMode::off) flow_ms.push_back(dyn.flow_ms);
+    if (uses_semantics(dynamic.mode)) {
+      semantic_wait_ms.push_back(dyn.semantic_wait_ms);
+      if (dyn.mask_age_frames < 0) {
+        ++frames_without_mask;
+      } else {
+        mask_age_frames.push_back(dyn.mask_age_frames);
+        mask_latency_ms.push_back(dyn.mask_latency_ms);
+        // Count each mask's inference once (a mask may serve several frames in real time).
+        if (dyn.semantic_inference_ms != last_inference_ms) semantic_ms.push_back(dyn.semantic_inference_ms);
+        last_inference_ms = dyn.semantic_inference_ms;
+      }
+    }
+    if (dyn.geometry_ran) {
+      geometry_ms.push_back(dyn.geometry_ms);
+      geometry_search_ms.push_back(dyn.geometry_search_ms);
+    }
+    tested_points += dyn.tested_points;
+    dynamic_points += dyn.dynamic_points;
+    masked_keypoints += dyn.masked_keypoints;
+    culled_points += dyn.culled_map_points;
     ++processed;
     progress.update(processed);
   }
@@ -166,10 +316,13 @@ int run_command(const std::vector<std::string>& args) {
   std::cout << "output:       " << (out_dir / "trajectory.txt").string() << " ("
             << trajectory.count()
             << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
+  std::optional<AteResult> ate_tracked;
+  std::optional<AteResult> ate_refined;
   if (sequence.ground_truth() && estimate.size() >= 3) {
-    const std::pair<const char*, const Trajectory*> evaluated[] = {
-        {"trajectory.txt        ", &estimate}, {"trajectory_refined.txt", &refined}};
-    for (const auto& [name, poses] : evaluated) {
+    const std::tuple<const char*, const Trajectory*, std::optional<AteResult>*> evaluated[] = {
+        {"trajectory.txt        ", &estimate, &ate_tracked},
+        {"trajectory_refined.txt", &refined, &ate_refined}};
+    for (const auto& [name, poses, slot] : evaluated) {
       try {
         const AteResult ate = compute_ate(*sequence.ground_truth(), *poses);
         std::snprintf(line, sizeof(line),
@@ -178,11 +331,85 @@ int run_command(const std::vector<std::string>& args) {
                       name, ate.error.count, ate.error.rmse, ate.error.mean, ate.error.median,
                       ate.error.max);
         std::cout << line;
+        *slot = ate;
       } catch (const Error& e) {
         std::cout << "ATE " << name << ": not computed: " << e.what() << "\n";
       }
     }
   }
+
+  // Per-module timing and the dynamic-feature totals, printed and written to stats.json.
+  const TimingSummary t_extraction = summarize(extraction_ms);
+  const TimingSummary t_semantic = summarize(semantic_ms);
+  const TimingSummary t_semantic_wait = summarize(semantic_wait_ms);
+  const TimingSummary t_geometry = summarize(geometry_ms);
+  const TimingSummary t_search = summarize(geometry_search_ms);
+  const TimingSummary t_flow = summarize(flow_ms);
+  const TimingSummary t_tracking = summarize(tracking_ms);
+  const TimingSummary t_mapping = summarize(local_mapping_ms);
+  const TimingSummary mask_age = summarize(mask_age_frames);
+  const TimingSummary mask_latency = summarize(mask_latency_ms);
+  std::snprintf(line, sizeof(line),
+                "timing ms:    median/mean/p95  extraction %.1f/%.1f/%.1f  semantic inference "
+                "%.1f/%.1f/%.1f (waited %.1f/%.1f/%.1f)\n"
+                "              geometry %.1f/%.1f/%.1f (search %.1f)  flow+H %.1f  tracking "
+                "%.1f/%.1f/%.1f  local BA %.1f/%.1f/%.1f\n",
+                t_extraction.median, t_extraction.mean, t_extraction.p95, t_semantic.median,
+                t_semantic.mean, t_semantic.p95, t_semantic_wait.median, t_semantic_wait.mean,
+                t_semantic_wait.p95, t_geometry.median, t_geometry.mean, t_geometry.p95,
+                t_search.median, t_flow.median, t_tracking.median, t_tracking.mean,
+                t_tracking.p95, t_mapping.median, t_mapping.mean, t_mapping.p95);
+  std::cout << line;
+  std::snprintf(line, sizeof(line),
+                "dynamic:      mode %s; %zu keypoints tested, %zu flagged by geometry, %zu "
+                "dropped before tracking, %zu map points culled; mask age median %.0f frames "
+                "(%.0f ms), %zu frames without mask, %zu frames dropped by the real-time feed\n",
+                to_string(dynamic.mode), tested_points, dynamic_points, masked_keypoints,
+                culled_points, mask_age.median, mask_latency.median, frames_without_mask,
+                realtime_dropped);
+  std::cout << line;
+
+  {
+    std::ofstream json = open_output(out_dir / "stats.json");
+    const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
+    json << "{\n  \"sequence\": \"" << sequence.directory().string() << "\",\n"
+         << "  \"mode\": \"" << to_string(dynamic.mode) << "\",\n"
+         << "  \"realtime\": " << (dynamic.realtime ? "true" : "false") << ",\n"
+         << "  \"interrupted\": " << (interrupted() ? "true" : "false") << ",\n"
+         << "  \"frames\": " << processed << ",\n"
+         << "  \"lost_frames\": " << lost_count << ",\n"
+         << "  \"realtime_dropped_frames\": " << realtime_dropped << ",\n"
+         << "  \"seconds\": " << seconds << ",\n"
+         << "  \"fps\": " << fps << ",\n"
+         << "  \"timing_ms\": {\n"
+         << "    \"extraction\": " << json_timing(t_extraction) << ",\n"
+         << "    \"semantic\": " << json_timing(t_semantic) << ",\n"
+         << "    \"semantic_wait\": " << json_timing(t_semantic_wait) << ",\n"
+         << "    \"geometry\": " << json_timing(t_geometry) << ",\n"
+         << "    \"geometry_search\": " << json_timing(t_search) << ",\n"
+         << "    \"flow_homography\": " << json_timing(t_flow) << ",\n"
+         << "    \"tracking\": " << json_timing(t_tracking) << ",\n"
+         << "    \"local_mapping\": " << json_timing(t_mapping) << "\n  },\n"
+         << "  \"dynamic\": {\"tested_points\": " << tested_points
+         << ", \"dynamic_points\": " << dynamic_points
+         << ", \"masked_keypoints\": " << masked_keypoints
+         << ", \"culled_map_points\": " << culled_points
+         << ", \"frames_without_mask\": " << frames_without_mask << "},\n"
+         << "  \"mask_latency\": {\"frames\": " << json_timing(mask_age)
+         << ", \"ms\": " << json_timing(mask_latency) << "},\n"
+         << "  \"map\": {\"keyframes\": " << mapping.keyframes_in_map
+         << ", \"map_points\": " << mapping.map_points << "}";
+    const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
+        {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
+    for (const auto& [key, ate] : ates) {
+      if (!*ate) continue;
+      json << ",\n  \"" << key << "\": {\"rmse\": " << (*ate)->error.rmse
+           << ", \"mean\": " << (*ate)->error.mean << ", \"median\": " << (*ate)->error.median
+           << ", \"max\": " << (*ate)->error.max << ", \"poses\": " << (*ate)->error.count << "}";
+    }
+    json << "\n}\n";
+  }
+  std::cout << "stats:        " << (out_dir / "stats.json").string() << "\n";
   if (interrupted()) {
     std::cout << "interrupted after " << processed << " of " << frames
               << " frames; trajectory.txt holds every pose computed so far\n";

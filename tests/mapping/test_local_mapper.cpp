@@ -26,9 +26,12 @@ void expect_consistent(const Map& map) {
     }
   }
   for (const auto& keyframe : map.keyframes()) {
-    for (const auto& point : keyframe->map_points()) {
-      if (!point) continue;
-      EXPECT_TRUE(live_points.contains(point->id())) << "dangling " << point->id();
+    const auto points = keyframe->map_points();
+    for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+      if (!points[i]) continue;
+      EXPECT_TRUE(live_points.contains(points[i]->id())) << "dangling " << points[i]->id();
+      EXPECT_EQ(points[i]->keypoint_index_in(keyframe->id()), i)
+          << "keyframe " << keyframe->id() << " keypoint " << i << " unknown to its point";
     }
   }
 }
@@ -162,32 +165,39 @@ TEST(LocalMapper, FirstKeyframeCreatesPointsFromDepthOnly) {
   }
 }
 
+// Associations of `keyframe` whose map point stands for another world point than the keypoint.
+int count_wrong_associations(const SyntheticWorld& world, const KeyFrame& keyframe) {
+  int wrong = 0;
+  const auto points = keyframe.map_points();
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    if (points[i]) wrong += world.world_index(keyframe.id(), i) != world.world_index(*points[i]);
+  }
+  return wrong;
+}
+
 TEST(LocalMapper, BundleAdjustmentRemovesWrongAssociations) {
   SyntheticWorld world(700, 0.2, 24);
   auto map = std::make_shared<Map>();
   LocalMapper mapper(map, LocalMappingOptions{});
   const int num_keyframes = 5;
+  int injected = 0;
   for (int k = 0; k < num_keyframes; ++k) {
     const Pose pose = testing::path_pose(k);
     // From the third keyframe on, 5% of tracking's matches point at the wrong map point.
-    mapper.process(world.make_keyframe(k, pose, pose, *map, k >= 2 ? 0.05 : 0.0));
+    const auto keyframe = world.make_keyframe(k, pose, pose, *map, k >= 2 ? 0.05 : 0.0);
+    injected += count_wrong_associations(world, *keyframe);
+    mapper.process(keyframe);
   }
-  EXPECT_GT(mapper.stats().ba_outliers_removed, 5u);
+  ASSERT_GT(injected, 30);
+  EXPECT_GT(mapper.stats().ba_outliers_removed, static_cast<std::uint64_t>(injected / 2));
   expect_consistent(*map);
-  // What survives is right: each observation's keypoint shows the point's own world point.
-  int wrong = 0, total = 0;
+  // Nearly all wrong matches are gone. A few cannot be told apart: a point seen once without
+  // depth plus one wrong match is triangulated to where both agree.
+  int remaining = 0;
   for (const auto& keyframe : map->keyframes()) {
-    const auto points = keyframe->map_points();
-    for (int i = 0; i < static_cast<int>(points.size()); ++i) {
-      if (!points[i]) continue;
-      ++total;
-      // A wrong match that the map then adopted may name either world point; count mismatches
-      // against the point's first observation.
-      wrong += world.world_index(keyframe->id(), i) != world.world_index(*points[i]);
-    }
+    remaining += count_wrong_associations(world, *keyframe);
   }
-  EXPECT_GT(total, 1000);
-  EXPECT_LT(wrong, total / 200) << wrong << " wrong of " << total;
+  EXPECT_LT(remaining, injected / 4) << remaining << " of " << injected << " wrong matches left";
 }
 
 }  // namespace

@@ -230,6 +230,28 @@ TEST(SemanticThread, RejectsNonIncreasingIdsAndUnknownDynamicClasses) {
   }
 }
 
+class ThrowingSegmenter : public FakeSegmenter {
+ public:
+  using FakeSegmenter::FakeSegmenter;
+  LabelMap segment(const cv::Mat& bgr) override {
+    if (bgr.at<cv::Vec3b>(0, 0)[0] == 2) throw Error("frame 2 is broken");
+    return FakeSegmenter::segment(bgr);
+  }
+};
+
+TEST(SemanticThread, AFailingFrameIsReportedAndTheThreadGoesOn) {
+  auto control = std::make_shared<FakeSegmenter::Control>();
+  SemanticThread thread(std::make_unique<ThrowingSegmenter>(control, 0ms), SemanticParams{});
+  thread.submit(2, 2.0, frame_image(2));
+  EXPECT_EQ(thread.wait_for(2, 5s), nullptr);
+  thread.submit(3, 3.0, frame_image(3));
+  ASSERT_NE(thread.wait_for(3, 5s), nullptr);
+  const SemanticStats stats = thread.stats();
+  EXPECT_EQ(stats.failed, 1);
+  EXPECT_EQ(stats.processed, 1);
+  EXPECT_EQ(stats.last_error, "frame 2 is broken");
+}
+
 TEST(DynamicMask, MarksDynamicLabelsAndGrowsByTheMargin) {
   LabelMap labels(40, 50, CV_8UC1, cv::Scalar(0));
   labels(cv::Rect(10, 10, 5, 5)).setTo(15);  // person

@@ -56,11 +56,18 @@ void LocalMapper::insert_keyframe_into_map(const std::shared_ptr<KeyFrame>& keyf
   for (int i = 0; i < static_cast<int>(points.size()); ++i) {
     const auto& point = points[i];
     if (!point) continue;
+    const int observed_index = point->keypoint_index_in(keyframe->id());
+    if (observed_index >= 0 && observed_index != i) {
+      // Tracking matched the point to two keypoints; a point has one observation per keyframe,
+      // so the second association would be invisible to BA and culling. Keep the first.
+      keyframe->erase_map_point(i);
+      continue;
+    }
     if (point->first_keyframe_id == keyframe->id()) {
       // Created by tracking together with this keyframe: it starts its probation here.
-      if (!point->is_observed_by(keyframe->id())) point->add_observation(keyframe, i);
+      if (observed_index < 0) point->add_observation(keyframe, i);
       created_for_keyframe.push_back(point);
-    } else if (!point->is_observed_by(keyframe->id())) {
+    } else if (observed_index < 0) {
       point->add_observation(keyframe, i);
       point->update_normal_and_depth(keyframe->pyramid());
       point->compute_distinctive_descriptor();

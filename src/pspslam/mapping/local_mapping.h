@@ -5,11 +5,12 @@
 // Expected call pattern (tracking / System):
 //   auto mapping = std::make_unique<LocalMapping>(map, config);   // thread starts here
 //   // or LocalMapping(map, LocalMappingOptions{...}) to tune thresholds
-//   // tracking, when it decides on a new keyframe:
-//   if (mapping->accepts_keyframes() || mapping->queue_size() < 3) {
-//     mapping->insert_keyframe(keyframe);   // also interrupts a running local BA
+//   // tracking, when it wants a new keyframe (ORB-SLAM2's RGB-D policy):
+//   if (mapping->accepts_keyframes()) {
+//     mapping->insert_keyframe(keyframe);
 //   } else {
-//     mapping->interrupt_bundle_adjustment();
+//     mapping->interrupt_bundle_adjustment();   // make the mapper free up soon
+//     if (mapping->queue_size() < 3) mapping->insert_keyframe(keyframe);  // also interrupts BA
 //   }
 //   mapping->wait_until_idle();             // optional: deterministic offline runs / tests
 //   mapping->request_stop(); ... is_stopped() ... mapping->release();   // e.g. loop closing

@@ -86,12 +86,14 @@ void SemanticThread::run() {
     try {
       result->labels = segmenter_->segment(job.bgr);
       result->dynamic_mask = dynamic_mask(result->labels, dynamic_ids_, dilation_px_);
-    } catch (...) {
-      // A failing frame must not kill the thread silently with frames still expected:
-      // publish nothing for it, count it as dropped.
+    } catch (const std::exception& e) {
+      // A failing frame must not end the thread: nothing is published for it (consumers
+      // waiting for it are released), and the failure is counted and kept for stats().
       std::lock_guard lock(mutex_);
       busy_ = false;
       ++stats_.dropped;
+      ++stats_.failed;
+      stats_.last_error = e.what();
       last_finished_id_ = std::max(last_finished_id_, job.frame_id);
       done_cv_.notify_all();
       continue;

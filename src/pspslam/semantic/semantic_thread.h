@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -32,7 +33,9 @@ struct SemanticResult {
 struct SemanticStats {
   std::int64_t submitted = 0;
   std::int64_t processed = 0;
-  std::int64_t dropped = 0;  // replaced by a newer frame before they were started
+  std::int64_t dropped = 0;  // replaced by a newer frame before they were started, or failed
+  std::int64_t failed = 0;   // segment() threw: nothing published for that frame
+  std::string last_error;    // what() of the last failure
 };
 
 // Runs a Segmenter on its own thread (paper Fig. 1: the semantic thread beside tracking).

@@ -1,15 +1,41 @@
-// Thread layout of the SLAM system:
+// Thread layout of the SLAM system (PSPNet-SLAM, paper Fig. 1):
 //
-//   caller thread           System::track(): ORB extraction -> Frame -> Tracker::track()
-//                             (holds Map::update_mutex() while it works on one frame)
+//   semantic thread         SemanticThread (semantic/): one Segmenter (our PSPNet over ONNX);
+//     (modes semantic,        frames are announce()d ahead of process(), so the network works on
+//      full, exhaustive)      frame i+1 while the caller tracks frame i; publishes label maps and
+//                             dilated dynamic-class masks by frame id
+//                                  | newest / own-frame mask
+//                                  v
+//   caller thread           System::process(), per frame, in this order:
+//                             1. LK flow previous -> current frame and the compensated
+//                                homography H (eq. 10-11); recorded in a HomographyChain
+//                             2. semantic mask: deterministic = wait for this frame's own mask;
+//                                --realtime = never wait, take the newest mask and warp it
+//                                through the chained H of the frames since (mask_warper.h)
+//                             3. ORB extraction with the semantic mask as extraction mask (no
+//                                features on people), then the Frame is built
+//                             4. geometry stage (geometry/) on the extracted keypoints: pose prior
+//                                = constant-velocity prediction from the last two tracked poses,
+//                                references = depth images of the newest keyframes, priority =
+//                                previous fused mask warped by H; the search is the ant colony
+//                                (full) or every point (exhaustive); flagged keypoints and those
+//                                inside grown regions are dropped *before* the Frame exists, so
+//                                they are neither tracked nor turned into map points
+//                             5. Tracker::track() (holds Map::update_mutex() while it works)
+//                             6. map points of the local map that project onto the fused mask
+//                                with matching depth are counted; repeat offenders are erased
 //                                  | KeyFrameSink::insert_keyframe (keyframe already in Map)
 //                                  v
 //   local mapping thread    LocalMapping (mapping/): queue of keyframes; per keyframe point
 //                             culling, triangulation, fusion, local BA, keyframe culling; it
 //                             takes Map::update_mutex() while it writes BA results back
 //
-// Later issues add the semantic and geometry threads in front of tracking (they produce the
-// dynamic mask passed to track()).
+// Why geometry runs on the caller thread, after extraction and before tracking: it needs the
+// frame's keypoints (extraction) and a pose (the motion-model prior is good to a few cm at 30 Hz,
+// and the multi-view test's patch absorbs that), and its verdict must be in before tracking so
+// that dynamic features never touch the map. A separate thread would only wait for extraction
+// and then make tracking wait for it; on a 2-core machine shared with the semantic network there
+// is no idle core to win. The first frames (no prior, no keyframe yet) run without geometry.
 #include "pspslam/system/system.h"
 
 #include <algorithm>
@@ -18,14 +44,21 @@
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 
+#include "pspslam/dynamic/frame_flow.h"
+#include "pspslam/dynamic/keypoint_fusion.h"
+#include "pspslam/dynamic/mask_warper.h"
 #include "pspslam/feature/orb_extractor.h"
+#include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
+#include "pspslam/map/map_point.h"
 #include "pspslam/mapping/local_mapping.h"
+#include "pspslam/semantic/onnx_segmenter.h"
+#include "pspslam/semantic/semantic_thread.h"
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
@@ -111,6 +144,204 @@ class System::MappingConnection final : public KeyFrameSink {
   LocalMappingStats last_;
 };
 
+
+// The dynamic-scene stages around tracking and their state between frames (steps 1, 2, 4, 6 of
+// the layout above). Owns the semantic thread; everything else runs on the caller's thread.
+class System::DynamicPipeline {
+ public:
+  DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera, Map& map)
+      : options_(options), camera_(camera), map_(map), culler_(options.culling) {
+    GeometryParams geometry = options.geometry;
+    if (options.mode == DynamicMode::full) geometry.search.strategy = SearchStrategy::ant_colony;
+    if (options.mode == DynamicMode::exhaustive)
+      geometry.search.strategy = SearchStrategy::exhaustive;
+    if (uses_geometry(options.mode))
+      geometry_ = std::make_unique<GeometryStage>(camera, geometry);
+    if (uses_semantics(options.mode)) {
+      SemanticParams params = options.semantic;
+      // Deterministic mode announces one frame ahead: two may be pending and none may be
+      // dropped. Real-time mode keeps only the newest pending frame.
+      params.queue_size = options.realtime ? 1 : 2;
+      semantic_ = std::make_unique<SemanticThread>(OnnxSegmenter::from_file(options.model), params);
+    }
+  }
+
+  void announce(const RgbdFrame& frame) {
+    if (!semantic_) return;
+    const std::int64_t id = next_announced_++;
+    submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
+    while (submitted_.size() > 64) submitted_.pop_front();
+    semantic_->submit(id, frame.timestamp, frame.bgr);
+  }
+
+  // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
+  // when none is usable).
+  cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report) {
+    current_id_ = next_id_++;
+    if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
+    const auto start = std::chrono::steady_clock::now();
+    H_previous_to_current_.reset();
+    if (geometry_ || (semantic_ && options_.realtime)) {
+      flow_.track(previous_gray_, gray, previous_points_);
+      const CompensatedHomography H = estimate_compensated_homography(
+          std::span<const Eigen::Vector2d>(flow_.matched_previous()),
+          std::span<const Eigen::Vector2d>(flow_.matched_current()), options_.geometry.homography);
+      if (H.valid) H_previous_to_current_ = H.H;
+    }
+    chain_.record(current_id_, H_previous_to_current_);
+    previous_gray_ = gray;
+    report.flow_ms = milliseconds_since(start);
+    return semantic_ ? semantic_mask(report) : cv::Mat();
+  }
+
+  // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
+  void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
+                      DynamicReport& report) {
+    geometry_mask_.release();
+    const std::vector<std::uint8_t>* geometry_flags = nullptr;
+    if (geometry_ && prior_pose() && !references_.empty()) {
+      const auto start = std::chrono::steady_clock::now();
+      pixels_.resize(features.keypoints.size());
+      // Distorted pixel positions: the depth image is registered to the distorted image, and
+      // the lens distortion of Kinect-class presets moves pixels by less than the test's patch.
+      for (size_t i = 0; i < features.keypoints.size(); ++i)
+        pixels_[i] = {features.keypoints[i].pt.x, features.keypoints[i].pt.y};
+      views_.clear();
+      for (const auto& reference : references_) {
+        if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
+          views_.push_back({keyframe->T_world_camera(), reference.depth});
+      }
+      GeometryFrameInput input;
+      input.depth = depth;
+      input.T_world_camera = *prior_pose();
+      input.keypoints = pixels_;
+      input.references = views_;
+      // Already in this frame's coordinates, so the stage needs no homography of its own.
+      if (!previous_mask_.empty() && H_previous_to_current_)
+        input.previous_dynamic_mask =
+            warp_to_current(previous_mask_, *H_previous_to_current_, depth.size(), true);
+      GeometryFrameResult result = geometry_->process(input);
+      report.geometry_ms = milliseconds_since(start);
+      report.geometry_search_ms = result.timing.search_ms;
+      report.geometry_ran = true;
+      report.tested_points = result.tested_count;
+      report.dynamic_points = result.dynamic_count;
+      geometry_flags_ = std::move(result.keypoint_dynamic);
+      geometry_flags = &geometry_flags_;
+      geometry_mask_ = std::move(result.dynamic_mask);
+    }
+    fuse_keypoint_flags(features.keypoints, semantic_mask,
+                        geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)
+                                       : std::span<const std::uint8_t>(),
+                        dynamic_flags_);
+    report.masked_keypoints =
+        remove_flagged_keypoints(dynamic_flags_, features.keypoints, features.descriptors);
+    // Static keypoints of this frame seed the next frame's optical flow.
+    previous_points_.clear();
+    for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
+  }
+
+  // Step 6 and the state for the next frame.
+  void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
+                 DynamicReport& report) {
+    previous_mask_ = fuse_dynamic_masks(semantic_mask, geometry_mask_, 0);
+    if (result.keyframe_inserted && geometry_) {
+      if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
+        // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
+        references_.push_front({keyframe, depth});
+        const size_t keep = static_cast<size_t>(options_.geometry.multiview.max_reference_views);
+        while (references_.size() > keep) references_.pop_back();
+      }
+    }
+    if (result.T_world_camera) {
+      if (last_pose_ && last_pose_id_ + 1 == current_id_) {
+        velocity_ = last_pose_->inverse() * *result.T_world_camera;  // T_last_current
+      } else {
+        velocity_.reset();
+      }
+      last_pose_ = result.T_world_camera;
+      last_pose_id_ = current_id_;
+      if (!previous_mask_.empty()) {
+        const auto points = map_.reference_map_points();
+        const auto& culled = culler_.observe(points, *result.T_world_camera, previous_mask_,
+                                             depth, camera_);
+        if (!culled.empty()) {
+          std::lock_guard lock(map_.update_mutex());
+          for (const auto& point : culled) map_.erase_map_point(point);
+        }
+        report.culled_map_points = static_cast<int>(culled.size());
+      }
+    }
+  }
+
+ private:
+  struct Reference {
+    std::weak_ptr<KeyFrame> keyframe;  // its pose is read at use: local BA keeps refining it
+    cv::Mat depth;
+  };
+  struct Submitted {
+    std::int64_t id = 0;
+    Timestamp timestamp = 0.0;
+    std::chrono::steady_clock::time_point time;
+  };
+
+  cv::Mat semantic_mask(DynamicReport& report) {
+    std::shared_ptr<const SemanticResult> result;
+    if (!options_.realtime) {
+      const auto start = std::chrono::steady_clock::now();
+      result = semantic_->wait_for(current_id_, options_.semantic_timeout);
+      report.semantic_wait_ms = milliseconds_since(start);
+    }
+    if (!result) result = semantic_->newest();
+    if (!result || result->frame_id > current_id_) return {};
+    const WarpedMask warped =
+        warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
+    if (warped.mask.empty()) return {};
+    report.mask_age_frames = warped.age_frames;
+    report.mask_warped = warped.warped;
+    report.semantic_inference_ms = result->inference_ms;
+    for (const Submitted& submitted : submitted_) {
+      if (submitted.id == result->frame_id) report.mask_latency_ms = milliseconds_since(submitted.time);
+    }
+    return warped.mask;
+  }
+
+  std::optional<Pose> prior_pose() const {
+    if (!last_pose_ || last_pose_id_ + 1 != current_id_) return std::nullopt;
+    // Constant velocity, as tracking's own motion model.
+    return velocity_ ? *last_pose_ * *velocity_ : *last_pose_;
+  }
+
+  DynamicOptions options_;
+  PinholeCamera camera_;
+  Map& map_;
+  std::unique_ptr<SemanticThread> semantic_;
+  std::unique_ptr<GeometryStage> geometry_;
+  FrameFlow flow_;
+  HomographyChain chain_;
+  DynamicPointCuller culler_;
+
+  std::int64_t next_id_ = 0;         // processed frames
+  std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
+  std::int64_t current_id_ = 0;
+  std::deque<Submitted> submitted_;
+  std::deque<Reference> references_;  // newest keyframe first
+  std::optional<Eigen::Matrix3d> H_previous_to_current_;
+  cv::Mat previous_gray_;
+  cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
+  cv::Mat geometry_mask_;
+  std::optional<Pose> last_pose_;
+  std::optional<Pose> velocity_;
+  std::int64_t last_pose_id_ = -1;
+
+  // Per-frame buffers, reused.
+  std::vector<cv::Point2f> previous_points_;
+  std::vector<Eigen::Vector2d> pixels_;
+  std::vector<DepthView> views_;
+  std::vector<std::uint8_t> geometry_flags_;
+  std::vector<std::uint8_t> dynamic_flags_;
+};
+
 System::System(const SystemConfig& config, SystemOptions options)
     : camera_(std::make_shared<const RgbdCamera>(
           RgbdCamera::from_config(config.camera, options.virtual_baseline))),
@@ -127,6 +358,9 @@ System::System(const SystemConfig& config, SystemOptions options)
   // ORB-SLAM2 wants a keyframe at least once per second of video.
   options.tracker.keyframes.max_frames_between = static_cast<int>(config.camera.fps);
   tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker);
+  dynamic_options_ = options.dynamic;
+  if (options.dynamic.mode != DynamicMode::off)
+    dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
 }
 
 System::~System() { shutdown(); }
@@ -154,6 +388,38 @@ FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Ma
   report.tracking = tracker_->track(std::move(frame));
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
+  return report;
+}
+
+void System::announce(const RgbdFrame& frame) {
+  if (dynamic_) dynamic_->announce(frame);
+}
+
+FrameReport System::process(const RgbdFrame& frame) {
+  if (!dynamic_) return track(frame);
+  FrameReport report;
+  const double cpu_start = thread_cpu_ms();
+  cv::Mat gray = frame.gray;
+  if (gray.empty()) cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+  const cv::Mat semantic_mask = dynamic_->begin_frame(frame, gray, report.dynamic);
+
+  const auto extraction_start = std::chrono::steady_clock::now();
+  OrbFeatures features;
+  extractor_->extract(gray, semantic_mask, features);
+  report.extraction_ms = milliseconds_since(extraction_start);
+  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic);
+  const auto frame_start = std::chrono::steady_clock::now();
+  Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),
+                      std::move(features.descriptors), frame.depth, camera_, pyramid_);
+  report.extraction_ms += milliseconds_since(frame_start);
+  report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
+
+  const double cpu_tracking_start = thread_cpu_ms();
+  const auto tracking_start = std::chrono::steady_clock::now();
+  report.tracking = tracker_->track(std::move(tracked_frame));
+  report.tracking_ms = milliseconds_since(tracking_start);
+  report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
+  dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
   return report;
 }
 

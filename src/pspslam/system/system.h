@@ -1,10 +1,20 @@
 #pragma once
 
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
+#include "pspslam/dynamic/dynamic_mode.h"
+#include "pspslam/dynamic/dynamic_point_culler.h"
+#include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/semantic/semantic_params.h"
 #include "pspslam/tracking/tracker.h"
 
 namespace pspslam {
@@ -16,12 +26,46 @@ struct RgbdFrame;
 struct RgbdCamera;
 struct ScalePyramid;
 
+// How dynamic content is detected and removed (issue #7; `pspslam run --dynamic`).
+struct DynamicOptions {
+  DynamicMode mode = DynamicMode::off;
+  // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
+  std::filesystem::path model;
+  // true: never wait for segmentation, use the newest mask warped into the frame (live camera).
+  // false: wait for each frame's own mask (reproducible accuracy runs).
+  bool realtime = false;
+  // mask_dilation_px is the semantic margin; queue_size is set by the system from `realtime`.
+  SemanticParams semantic;
+  GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
+  DynamicCullingParams culling;
+  // Deterministic mode gives up on a frame's mask after this long (then runs without it).
+  std::chrono::milliseconds semantic_timeout{30000};
+};
+
 struct SystemOptions {
   // ORB-SLAM2's virtual stereo baseline for RGB-D (u_r = u - fx * b / z), metres.
   double virtual_baseline = 0.08;
   TrackerOptions tracker;
   // false: keyframes go into the map but no local mapping runs (tests, debugging).
   bool local_mapping = true;
+  DynamicOptions dynamic;
+};
+
+// What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
+struct DynamicReport {
+  double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
+  double semantic_wait_ms = 0.0;     // time tracking blocked waiting for the mask
+  double semantic_inference_ms = 0;  // inference time of the mask used (0: none used)
+  double geometry_ms = 0.0;          // multi-view test + search + region growing
+  double geometry_search_ms = 0.0;   // of which: the (ant-colony or exhaustive) search
+  int mask_age_frames = -1;          // current frame - the mask's frame; -1: no mask
+  double mask_latency_ms = 0.0;      // from submitting the mask's frame until its use here
+  bool mask_warped = false;
+  bool geometry_ran = false;         // false without a pose prior or reference keyframes
+  int tested_points = 0;             // multi-view tests run
+  int dynamic_points = 0;            // keypoints geometry flagged (tested or in grown regions)
+  int masked_keypoints = 0;          // extracted keypoints dropped as dynamic before tracking
+  int culled_map_points = 0;         // map points erased for lying on dynamic pixels
 };
 
 // One frame through the system: the tracking result and where the time went.
@@ -33,6 +77,7 @@ struct FrameReport {
   // for a core, CPU time does not.
   double extraction_cpu_ms = 0.0;
   double tracking_cpu_ms = 0.0;
+  DynamicReport dynamic;
 };
 
 struct MappingStats {
@@ -64,6 +109,15 @@ class System {
   FrameReport track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
                     const cv::Mat& dynamic_mask = {});
 
+  // The full PSPNet-SLAM path (options.dynamic): semantic mask + geometry verdicts -> dynamic
+  // features removed -> tracking -> culling of map points on dynamic pixels. With mode `off` it
+  // is track(frame). frame.bgr is required for the semantic modes.
+  FrameReport process(const RgbdFrame& frame);
+  // Hands a frame to the semantic thread ahead of process(frame), so that its segmentation
+  // overlaps the tracking of the frame before (deterministic mode). Frames must be announced
+  // in the order they are processed; a frame not announced is submitted by process().
+  void announce(const RgbdFrame& frame);
+
   // Lets local mapping finish its queue, then stops its thread. Idempotent.
   void shutdown();
 
@@ -73,10 +127,12 @@ class System {
   // Tracker::refined_trajectory); call after shutdown().
   Trajectory refined_trajectory() const { return tracker_->refined_trajectory(); }
   MappingStats mapping_stats() const;
+  const DynamicOptions& dynamic_options() const { return dynamic_options_; }
   const Map& map() const { return *map_; }
 
  private:
   class MappingConnection;
+  class DynamicPipeline;
 
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
@@ -87,6 +143,10 @@ class System {
   std::unique_ptr<MappingConnection> mapping_;
   std::unique_ptr<Tracker> tracker_;
   std::uint64_t next_frame_id_ = 0;
+  DynamicOptions dynamic_options_;
+  // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
+  // Declared last: its threads stop before the tracker and map go away.
+  std::unique_ptr<DynamicPipeline> dynamic_;
 };
 
 }  // namespace pspslam

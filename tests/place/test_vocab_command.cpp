@@ -32,9 +32,13 @@ void write_pictures(const fs::path& dir, int count) {
         cv::circle(image, a, 5 + s % 25, colour, cv::FILLED);
       }
     }
-    fs::create_directories(dir / (i % 2 == 0 ? "a" : "b/c"));
-    cv::imwrite((dir / (i % 2 == 0 ? "a" : "b/c") / ("p" + std::to_string(i) + ".png")).string(),
-                image);
+    // Two folders, one nested: the images are found recursively.
+    const fs::path folder = dir / (i % 2 == 0 ? "a" : "b/c");
+    fs::create_directories(folder);
+    std::string name = "p";
+    name += std::to_string(i);  // GCC 12 misreports "p" + to_string(i) under -Wrestrict
+    name += ".png";
+    cv::imwrite((folder / name).string(), image);
   }
 }
 

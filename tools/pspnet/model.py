@@ -125,8 +125,9 @@ class PyramidPooling(nn.Module):
 
 
 class PSPNet(nn.Module):
-    def __init__(self, input_hw=(288, 384), width="1.0", branch_channels=64,
-                 head_channels=96, num_classes=NUM_CLASSES, dropout=0.1):
+    # Defaults = the shipped model (width 0.5, 4 x 32 pyramid channels, 64 head channels).
+    def __init__(self, input_hw=(288, 384), width="0.5", branch_channels=32,
+                 head_channels=64, num_classes=NUM_CLASSES, dropout=0.1):
         super().__init__()
         h, w = input_hw
         if h % 8 or w % 8:

@@ -145,11 +145,13 @@ int train(const std::vector<std::string>& args) {
   OrbFeatures features;
   std::vector<cv::Mat> image_descriptors;
   std::size_t total_descriptors = 0;
+  // Views without a single keypoint (smooth sky, gradients) are no training images.
   auto add_view = [&](const cv::Mat& gray) {
     extractor.extract(gray, cv::Mat(), features);
-    if (features.descriptors.rows == 0) return;
+    if (features.descriptors.rows == 0) return false;
     image_descriptors.push_back(features.descriptors.clone());
     total_descriptors += static_cast<std::size_t>(features.descriptors.rows);
+    return true;
   };
 
   std::cout << "training images: " << photos.size() << " photographs, " << synthetic_frames
@@ -158,13 +160,11 @@ int train(const std::vector<std::string>& args) {
                                std::cerr);
   size_t done = 0;
   size_t photo_views_used = 0;
+  size_t synthetic_used = 0;
   for (const fs::path& photo : photos) {
     const cv::Mat gray = cv::imread(photo.string(), cv::IMREAD_GRAYSCALE);
     if (gray.empty()) throw Error("vocab train: cannot read image '" + photo.string() + "'");
-    for (const cv::Mat& view : photo_views(gray)) {
-      add_view(view);
-      ++photo_views_used;
-    }
+    for (const cv::Mat& view : photo_views(gray)) photo_views_used += add_view(view) ? 1 : 0;
     extract_progress.update(++done);
   }
   if (synthetic_frames > 0) {
@@ -179,15 +179,15 @@ int train(const std::vector<std::string>& args) {
       for (int i = 0; i < count; ++i) {
         scene.render(static_cast<size_t>(i) * (kSynthSequenceFrames / kFramesPerSeed), frame, 0);
         cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-        add_view(gray);
+        synthetic_used += add_view(gray) ? 1 : 0;
         extract_progress.update(++done);
       }
     }
   }
   extract_progress.finish();
   std::cout << "descriptors: " << total_descriptors << " from " << image_descriptors.size()
-            << " images (" << photo_views_used << " photo views), extraction "
-            << seconds_since(start) << " s\n";
+            << " images (" << photo_views_used << " photograph views, " << synthetic_used
+            << " synthetic frames), extraction " << seconds_since(start) << " s\n";
   if (total_descriptors < static_cast<std::size_t>(params.branching)) {
     throw Error("vocab train: only " + std::to_string(total_descriptors) +
                 " descriptors found, need at least --k");

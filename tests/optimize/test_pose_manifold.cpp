@@ -35,16 +35,22 @@ TEST(PoseManifold, PlusIsLeftMultiplication) {
 }
 
 // The analytic tangent Jacobians of both residual kinds against central differences through Plus.
+// `disparity_row`: the depth row is the disparity weighed by the sensor model (DepthNoiseModel),
+// else ORB-SLAM2's u_r weighed like a pixel.
 template <int kDof, ObservationRows kRows>
-void check_bundle_jacobians(double huber_delta) {
+void check_bundle_jacobians(double huber_delta, bool disparity_row = false) {
   const PinholeCamera camera = testing::test_camera();
-  const StereoProjection model = StereoProjection::from(camera, testing::test_bf(camera));
+  DepthNoiseModel depth_noise;
+  depth_noise.enabled = disparity_row;
+  const StereoProjection model =
+      StereoProjection::from(camera, testing::test_bf(camera), depth_noise);
   const PoseManifold manifold;
   const PoseParameters pose =
       PoseParameters::from_pose(testing::make_pose({0.2, 0.1, -0.1}, {0.1, 0.2, 0.3}));
   Eigen::Vector3d point = pose.to_pose().inverse() * Eigen::Vector3d(0.4, -0.3, 2.0);
   Measurement<kDof> measured;
   measured.setConstant(300.0);
+  if constexpr (kDof == 3) measured(2) = 280.0;  // a 20 px disparity (≈2 m): u_r = u − 20
   const BundleReprojectionCost<kDof, kRows> cost(model, measured, 1.0 / 1.2, huber_delta);
   constexpr int kResiduals = 2;
 
@@ -111,6 +117,29 @@ TEST(ReprojectionError, MonocularJacobiansMatchFiniteDifferences) {
 TEST(ReprojectionError, RgbdJacobiansMatchFiniteDifferences) {
   check_bundle_jacobians<3, ObservationRows::kPixel>(0.0);
   check_bundle_jacobians<3, ObservationRows::kRightPadded>(0.0);
+  check_bundle_jacobians<3, ObservationRows::kPixel>(0.0, /*disparity_row=*/true);
+  check_bundle_jacobians<3, ObservationRows::kRightPadded>(0.0, /*disparity_row=*/true);
+}
+
+// The disparity row is whitened by the sensor's σ_d = bf σ_z(z) / z², not by the pixel σ.
+TEST(ReprojectionError, DisparityRowUsesTheDepthNoiseModel) {
+  const PinholeCamera camera = testing::test_camera();
+  const double bf = testing::test_bf(camera);
+  const DepthNoiseModel depth_noise;  // enabled by default
+  const StereoProjection model = StereoProjection::from(camera, bf, depth_noise);
+  const Eigen::Vector3d point(0.1, -0.2, 2.0);
+  const double u = camera.fx * point.x() / point.z() + camera.cx;
+  const double v = camera.fy * point.y() / point.z() + camera.cy;
+  // Measured 5 mm further than the point: σ_z(2 m) = 1.2 mm + 1.9 mm · 1.6² = 6.064 mm.
+  const double z_measured = 2.005;
+  const Measurement<3> measured(u, v, u - bf / z_measured);
+  Eigen::Vector3d r;
+  ASSERT_TRUE(whitened_residual<3>(model, measured, 1.0, point, r, nullptr));
+  EXPECT_NEAR(r(0), 0.0, 1e-9);
+  EXPECT_NEAR(r(1), 0.0, 1e-9);
+  const double sigma_d = bf * 0.006064 / (z_measured * z_measured);
+  EXPECT_NEAR(r(2), (bf / z_measured - bf / point.z()) / sigma_d, 1e-3);
+  EXPECT_NEAR(r(2), -0.005 / 0.006064, 2e-3);  // ≈ the depth error in σ_z units
 }
 
 TEST(ReprojectionError, HuberWeightedJacobiansAreScaledDerivatives) {
@@ -132,7 +161,8 @@ TEST(ReprojectionError, HuberScalingGivesTheRobustCost) {
 
 TEST(ReprojectionError, PointBehindCameraIsRejected) {
   const PinholeCamera camera = testing::test_camera();
-  const StereoProjection model = StereoProjection::from(camera, testing::test_bf(camera));
+  const StereoProjection model =
+      StereoProjection::from(camera, testing::test_bf(camera), DepthNoiseModel{});
   EXPECT_TRUE(std::isinf(
       chi_squared<2>(model, Eigen::Vector2d(320.0, 240.0), 1.0, Eigen::Vector3d(0.0, 0.0, -1.0))));
 }

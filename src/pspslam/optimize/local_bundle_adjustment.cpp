@@ -171,7 +171,7 @@ BaResult solve_bundle_adjustment(BaProblem& problem, const PinholeCamera& camera
   result.observation_inlier.assign(num_observations, 0);
   if (num_observations == 0) return result;
 
-  const StereoProjection model = StereoProjection::from(camera, bf);
+  const StereoProjection model = StereoProjection::from(camera, bf, options.depth_noise);
   std::vector<PoseParameters> poses;
   poses.reserve(problem.keyframes.size());
   for (const BaKeyframe& keyframe : problem.keyframes) {

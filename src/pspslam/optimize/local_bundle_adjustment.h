@@ -21,6 +21,7 @@
 
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/core/types.h"
+#include "pspslam/optimize/depth_noise_model.h"
 
 namespace pspslam {
 
@@ -59,6 +60,8 @@ struct BaOptions {
   double huber_delta_stereo = std::sqrt(7.815);
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
+  // Weight of the depth row of observations with depth (default: the sensor model).
+  DepthNoiseModel depth_noise;
   // Wall-clock budget for both stages together; stage 2 gets what stage 1 left.
   double max_seconds = 0.5;
   int num_threads = 1;

@@ -186,7 +186,7 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
   result.inlier.assign(observations.size(), 0);
   if (observations.empty()) return result;
 
-  const StereoProjection model = StereoProjection::from(camera, bf);
+  const StereoProjection model = StereoProjection::from(camera, bf, options.depth_noise);
   const ceres::Solver::Options solver_options = round_solver_options(options);
   Pose pose = initial_T_camera_world;
 

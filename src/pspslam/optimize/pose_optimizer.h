@@ -18,6 +18,7 @@
 
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/core/types.h"
+#include "pspslam/optimize/depth_noise_model.h"
 
 namespace pspslam {
 
@@ -48,6 +49,8 @@ struct PoseOptimizerOptions {
   // Fewer inliers than this after a round: stop, the pose is not constrained well enough to
   // keep refining (the remaining rounds would fit the few survivors).
   int min_inliers_to_continue = 10;
+  // Weight of the depth row of observations with depth (default: the sensor model).
+  DepthNoiseModel depth_noise;
 };
 
 // Refines initial_T_camera_world. Observations with right_u >= 0 constrain (u, v, u_r) with the

@@ -6,10 +6,12 @@
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/optimize/depth_noise_model.h"
 
 namespace pspslam {
 
@@ -17,13 +19,16 @@ namespace pspslam {
 // z turns into a right-image coordinate u_r = u − bf / z, so depth error is weighed in pixels.
 struct StereoProjection {
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0, bf = 0.0;
+  DepthNoiseModel depth_noise;
 
-  static StereoProjection from(const PinholeCamera& camera, double bf) {
-    return {camera.fx, camera.fy, camera.cx, camera.cy, bf};
+  static StereoProjection from(const PinholeCamera& camera, double bf,
+                               const DepthNoiseModel& depth_noise) {
+    return {camera.fx, camera.fy, camera.cx, camera.cy, bf, depth_noise};
   }
 };
 
-// kResiduals = 2: (u, v) only; kResiduals = 3: (u, v, u_r) for a keypoint with valid depth.
+// kResiduals = 2: (u, v) only; kResiduals = 3: (u, v, u_r) for a keypoint with valid depth (the
+// third row of the residual is u_r, or the disparity u − u_r with depth_noise.enabled).
 template <int kResiduals>
 using Measurement = Eigen::Matrix<double, kResiduals, 1>;
 
@@ -45,8 +50,19 @@ inline bool whitened_residual(const StereoProjection& model,
   const double u = model.fx * x_over_z + model.cx;
   residual(0) = measured(0) - u;
   residual(1) = measured(1) - (model.fy * y_over_z + model.cy);
-  if constexpr (kResiduals == 3) residual(2) = measured(2) - (u - model.bf * inv_z);
-  residual *= sqrt_information;
+  double sqrt_information_depth = sqrt_information;
+  if constexpr (kResiduals == 3) {
+    if (model.depth_noise.enabled) {
+      // Row 3 = measured − predicted disparity, whitened by the sensor's σ_d (see DepthNoiseModel).
+      const double disparity = std::max(measured(0) - measured(2), 1e-9);
+      sqrt_information_depth = model.depth_noise.sqrt_information(model.bf, disparity);
+      residual(2) = disparity - model.bf * inv_z;
+    } else {
+      residual(2) = measured(2) - (u - model.bf * inv_z);
+    }
+  }
+  residual.template head<2>() *= sqrt_information;
+  if constexpr (kResiduals == 3) residual(2) *= sqrt_information_depth;
 
   if (d_residual_d_point != nullptr) {
     auto& jacobian = *d_residual_d_point;
@@ -58,11 +74,18 @@ inline bool whitened_residual(const StereoProjection& model,
     jacobian(1, 1) = -model.fy * inv_z;
     jacobian(1, 2) = model.fy * y_over_z * inv_z;
     if constexpr (kResiduals == 3) {
-      jacobian(2, 0) = jacobian(0, 0);
-      jacobian(2, 1) = 0.0;
-      jacobian(2, 2) = jacobian(0, 2) - model.bf * inv_z * inv_z;
+      if (model.depth_noise.enabled) {
+        jacobian(2, 0) = 0.0;
+        jacobian(2, 1) = 0.0;
+        jacobian(2, 2) = model.bf * inv_z * inv_z;
+      } else {
+        jacobian(2, 0) = -model.fx * inv_z;
+        jacobian(2, 1) = 0.0;
+        jacobian(2, 2) = model.fx * x_over_z * inv_z - model.bf * inv_z * inv_z;
+      }
     }
-    jacobian *= sqrt_information;
+    jacobian.template topRows<2>() *= sqrt_information;
+    if constexpr (kResiduals == 3) jacobian.row(2) *= sqrt_information_depth;
   }
   return true;
 }

@@ -395,22 +395,22 @@ std::string Vocabulary::link_tree() {
 }
 
 WordId Vocabulary::word(const std::uint8_t* descriptor) const {
-  NodeId current = 0;
-  while (child_count_[current] != 0) {
-    const NodeId first = first_child_[current];
-    const NodeId end = first + child_count_[current];
-    NodeId best = first;
-    int best_distance = hamming_distance(descriptor, node_descriptor(first));
-    for (NodeId child = first + 1; child < end; ++child) {
-      const int distance = hamming_distance(descriptor, node_descriptor(child));
-      if (distance < best_distance) {
-        best_distance = distance;
-        best = child;
-      }
+  return word(descriptor, 0, nullptr);
+}
+
+NodeId Vocabulary::nearest_child(const std::uint8_t* descriptor, NodeId parent) const {
+  const NodeId first = first_child_[parent];
+  const NodeId end = first + child_count_[parent];
+  NodeId best = first;
+  int best_distance = hamming_distance(descriptor, node_descriptor(first));
+  for (NodeId child = first + 1; child < end; ++child) {
+    const int distance = hamming_distance(descriptor, node_descriptor(child));
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = child;
     }
-    current = best;
   }
-  return node_word_[current];
+  return best;
 }
 
 WordId Vocabulary::word(const std::uint8_t* descriptor, int node_level, NodeId* node) const {
@@ -418,18 +418,7 @@ WordId Vocabulary::word(const std::uint8_t* descriptor, int node_level, NodeId* 
   NodeId at_level = 0;
   int depth = 0;
   while (child_count_[current] != 0) {
-    const NodeId first = first_child_[current];
-    const NodeId end = first + child_count_[current];
-    NodeId best = first;
-    int best_distance = hamming_distance(descriptor, node_descriptor(first));
-    for (NodeId child = first + 1; child < end; ++child) {
-      const int distance = hamming_distance(descriptor, node_descriptor(child));
-      if (distance < best_distance) {
-        best_distance = distance;
-        best = child;
-      }
-    }
-    current = best;
+    current = nearest_child(descriptor, current);
     if (++depth == node_level) at_level = current;
   }
   if (depth < node_level) at_level = current;  // the word sits above the requested level

@@ -77,6 +77,8 @@ class Vocabulary {
   std::uint32_t training_images() const { return training_images_; }
 
  private:
+  // The child of `parent` whose centroid is nearest (Hamming) to the descriptor.
+  NodeId nearest_child(const std::uint8_t* descriptor, NodeId parent) const;
   Vocabulary() = default;
   // Derives first_child_, leaf word ids and depths from child_count_ (breadth-first order).
   // Returns an empty string when consistent, else what is wrong.

@@ -4,6 +4,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <limits>
 #include <random>
 
 #include "pspslam/optimize/local_bundle_adjustment.h"
@@ -32,7 +33,9 @@ Pose perturbed(const Pose& pose, std::mt19937& rng, double angle, double shift) 
   return delta * pose;
 }
 
-// Noisy (u, v, u_r) of point_world; u_r < 0 with probability 1 - depth_fraction.
+constexpr double kNoDepth = std::numeric_limits<double>::quiet_NaN();
+
+// Noisy (u, v, u_r) of point_world; u_r NaN (no depth) with probability 1 - depth_fraction.
 void measure(const PinholeCamera& camera, double bf, const Pose& T_camera_world,
              const Eigen::Vector3d& point_world, double depth_fraction, std::mt19937& rng,
              Eigen::Vector2d& pixel, double& right_u) {
@@ -41,7 +44,7 @@ void measure(const PinholeCamera& camera, double bf, const Pose& T_camera_world,
   const Eigen::Vector3d p = T_camera_world * point_world;
   const Eigen::Vector2d ideal = camera.project(p);
   pixel = ideal + Eigen::Vector2d(noise(rng), noise(rng));
-  right_u = has_depth(rng) ? ideal.x() - bf / p.z() + noise(rng) : -1.0;
+  right_u = has_depth(rng) ? ideal.x() - bf / p.z() + noise(rng) : kNoDepth;
 }
 
 void BM_OptimizePose(benchmark::State& state) {
@@ -55,7 +58,7 @@ void BM_OptimizePose(benchmark::State& state) {
   std::vector<PoseObservation> observations;
   for (int i = 0; i < num_observations; ++i) {
     const Eigen::Vector3d point = truth.inverse() * camera.unproject({u(rng), v(rng)}, z(rng));
-    PoseObservation observation{point, {}, -1.0, 1.0};
+    PoseObservation observation{point, {}, kNoDepth, 1.0};
     measure(camera, bf, truth, point, 0.8, rng, observation.pixel, observation.right_u);
     if (is_outlier(rng)) observation.pixel = {u(rng), v(rng)};
     observations.push_back(observation);
@@ -92,7 +95,7 @@ void BM_LocalBundleAdjustment(benchmark::State& state) {
     for (size_t p = 0; p < truth.points.size(); ++p) {
       const Eigen::Vector3d pc = truth.keyframes[k].T_camera_world * truth.points[p].position_world;
       if (pc.z() < 0.5 || !camera.in_image(camera.project(pc), 10.0)) continue;
-      BaObservation observation{k, p, {}, -1.0, 1.0};
+      BaObservation observation{k, p, {}, kNoDepth, 1.0};
       measure(camera, bf, truth.keyframes[k].T_camera_world, truth.points[p].position_world, 0.8,
               rng, observation.pixel, observation.right_u);
       start.observations.push_back(observation);

@@ -71,8 +71,9 @@ TimingSummary summarize(std::vector<double> values) {
 
 std::string json_timing(const TimingSummary& t) {
   char text[160];
-  std::snprintf(text, sizeof(text), "{\"median\": %.3f, \"mean\": %.3f, \"p95\": %.3f, \"count\": %zu}",
-                t.median, t.mean, t.p95, t.count);
+  std::snprintf(text, sizeof(text),
+                "{\"median\": %.3f, \"mean\": %.3f, \"p95\": %.3f, \"count\": %zu}", t.median,
+                t.mean, t.p95, t.count);
   return text;
 }
 
@@ -271,7 +272,8 @@ int run_command(const std::vector<std::string>& args) {
         mask_age_frames.push_back(dyn.mask_age_frames);
         mask_latency_ms.push_back(dyn.mask_latency_ms);
         // Count each mask's inference once (a mask may serve several frames in real time).
-        if (dyn.semantic_inference_ms != last_inference_ms) semantic_ms.push_back(dyn.semantic_inference_ms);
+        if (dyn.semantic_inference_ms != last_inference_ms)
+          semantic_ms.push_back(dyn.semantic_inference_ms);
         last_inference_ms = dyn.semantic_inference_ms;
       }
     }
@@ -357,8 +359,8 @@ int run_command(const std::vector<std::string>& args) {
                 t_extraction.median, t_extraction.mean, t_extraction.p95, t_semantic.median,
                 t_semantic.mean, t_semantic.p95, t_semantic_wait.median, t_semantic_wait.mean,
                 t_semantic_wait.p95, t_geometry.median, t_geometry.mean, t_geometry.p95,
-                t_search.median, t_flow.median, t_tracking.median, t_tracking.mean,
-                t_tracking.p95, t_mapping.median, t_mapping.mean, t_mapping.p95);
+                t_search.median, t_flow.median, t_tracking.median, t_tracking.mean, t_tracking.p95,
+                t_mapping.median, t_mapping.mean, t_mapping.p95);
   std::cout << line;
   std::snprintf(line, sizeof(line),
                 "dynamic:      mode %s; %zu keypoints tested, %zu flagged by geometry, %zu "

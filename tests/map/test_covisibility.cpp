@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "pspslam/map/frame.h"
@@ -129,6 +130,49 @@ TEST_F(CovisibilityTest, ReplacingAPointMovesObservations) {
   // kf1 already saw b at index 5: its slot for a is cleared instead of duplicated.
   EXPECT_EQ(kf1->map_point(0), nullptr);
   EXPECT_EQ(b[0]->num_observations(), 3);
+}
+
+// A point that loses its second observation turns bad inside MapPoint::erase_observation; nothing
+// on that path can reach the Map, so the Map must sweep it (issue #3 loose end (a)).
+TEST_F(CovisibilityTest, PointsThatTurnBadAreSweptFromTheMap) {
+  auto kf0 = make_keyframe(0);
+  auto kf1 = make_keyframe(10);
+  const auto points = share(kf0, 0, kf1, 0, 4);  // two observations without depth each
+  ASSERT_EQ(map_.num_map_points(), 4u);
+  kf1->erase_map_point(0);
+  EXPECT_TRUE(points[0]->erase_observation(kf1->id()));  // one observation left: bad
+  EXPECT_TRUE(points[0]->is_bad());
+  EXPECT_EQ(kf0->map_point(0), nullptr);  // set_bad detached it from kf0 too
+  EXPECT_EQ(map_.num_map_points(), 4u);   // ...but the Map still owns it
+  EXPECT_EQ(map_.erase_bad_map_points(), 1u);
+  EXPECT_EQ(map_.num_map_points(), 3u);
+  for (const auto& point : map_.map_points()) EXPECT_FALSE(point->is_bad());
+  EXPECT_EQ(map_.erase_bad_map_points(), 0u);
+}
+
+// A close point near the left border has a negative virtual right coordinate u − bf/z; it still
+// has depth (issue #3 loose end (c): "right_u < 0" used to mean "no depth").
+TEST_F(CovisibilityTest, NegativeRightCoordinateStillCountsAsDepth) {
+  const std::vector<cv::KeyPoint> keypoints = {cv::KeyPoint(cv::Point2f(5.0f, 100.0f), 31.0f),
+                                               cv::KeyPoint(cv::Point2f(300.0f, 100.0f), 31.0f)};
+  cv::Mat descriptors(2, 32, CV_8U, cv::Scalar(0));
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(0.5f));
+  depth.at<float>(100, 300) = 0.0f;  // no reading at the second keypoint
+  Frame frame(0, 0.0, keypoints, descriptors, depth, camera_, pyramid_);
+  ASSERT_TRUE(frame.has_depth(0));
+  EXPECT_NEAR(frame.right_u(0), 5.0 - camera_->bf / 0.5, 1e-3);
+  EXPECT_LT(frame.right_u(0), 0.0f);
+  EXPECT_FALSE(frame.has_depth(1));
+  EXPECT_TRUE(std::isnan(frame.right_u(1)));
+
+  frame.set_pose(Pose::Identity());
+  auto keyframe = std::make_shared<KeyFrame>(map_.next_keyframe_id(), frame);
+  auto with_depth = std::make_shared<MapPoint>(0, frame.unproject_world(0), keyframe);
+  with_depth->add_observation(keyframe, 0);
+  EXPECT_EQ(with_depth->num_observations(), 2);  // a depth observation counts twice
+  auto without_depth = std::make_shared<MapPoint>(1, Eigen::Vector3d(0.0, 0.0, 2.0), keyframe);
+  without_depth->add_observation(keyframe, 1);
+  EXPECT_EQ(without_depth->num_observations(), 1);
 }
 
 }  // namespace

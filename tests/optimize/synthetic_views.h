@@ -62,7 +62,7 @@ inline Eigen::Vector3d random_visible_point(const PinholeCamera& camera, const P
 
 struct NoisyMeasurement {
   Eigen::Vector2d pixel;
-  double right_u;      // < 0 without depth
+  double right_u;      // NaN without depth
   double information;  // 1 / σ² of the level
 };
 
@@ -78,7 +78,8 @@ inline NoisyMeasurement measure(const PinholeCamera& camera, double bf, const Po
   const Eigen::Vector2d pixel = camera.project(point_camera);
   NoisyMeasurement measurement;
   measurement.pixel = pixel + Eigen::Vector2d(noise(rng), noise(rng));
-  measurement.right_u = with_depth ? pixel.x() - bf / point_camera.z() + noise(rng) : -1.0;
+  measurement.right_u = with_depth ? pixel.x() - bf / point_camera.z() + noise(rng)
+                                   : std::numeric_limits<double>::quiet_NaN();
   measurement.information = 1.0 / (scale * scale);
   return measurement;
 }

@@ -71,6 +71,13 @@ BaScene make_scene(int num_keyframes, int num_fixed, int num_points, double dept
   return scene;
 }
 
+// make_scene draws u_r with pixel-sized noise: the ORB-SLAM2 u_r model is the matching one.
+BaOptions u_r_model_options() {
+  BaOptions options;
+  options.depth_noise.enabled = false;
+  return options;
+}
+
 // RMS over (u, v) of the whitened residual of the inlier observations: ≈ 1 at the noise level.
 double rms_whitened_reprojection(const BaProblem& problem, const std::vector<uint8_t>& inlier) {
   const PinholeCamera camera = test_camera();
@@ -113,7 +120,8 @@ void expect_ba_converges(double depth_fraction, double max_translation_error, ui
   const BaProblem start = scene.problem;
 
   const PinholeCamera camera = test_camera();
-  const BaResult result = solve_bundle_adjustment(scene.problem, camera, test_bf(camera));
+  const BaResult result =
+      solve_bundle_adjustment(scene.problem, camera, test_bf(camera), u_r_model_options());
 
   const double rms_after = rms_whitened_reprojection(scene.problem, result.observation_inlier);
   EXPECT_GT(rms_before, 5.0);
@@ -147,7 +155,7 @@ TEST(LocalBundleAdjustment, ExactMeasurementsRecoverTheTruth) {
     const Eigen::Vector3d p = scene.truth.keyframes[o.keyframe].T_camera_world *
                               scene.truth.points[o.point].position_world;
     o.pixel = camera.project(p);
-    if (o.right_u >= 0.0) o.right_u = o.pixel.x() - bf / p.z();
+    if (!std::isnan(o.right_u)) o.right_u = o.pixel.x() - bf / p.z();
   }
   BaOptions options;
   options.refine_iterations = 30;
@@ -157,7 +165,7 @@ TEST(LocalBundleAdjustment, ExactMeasurementsRecoverTheTruth) {
   // Points seen once without depth are free along their ray; all others must be exact.
   std::vector<int> constraints(scene.truth.points.size(), 0);
   for (const BaObservation& o : scene.problem.observations) {
-    constraints[o.point] += o.right_u >= 0.0 ? 2 : 1;
+    constraints[o.point] += std::isnan(o.right_u) ? 1 : 2;
   }
   double worst_point_error = 0.0;
   for (size_t p = 0; p < scene.truth.points.size(); ++p) {
@@ -185,7 +193,8 @@ TEST(LocalBundleAdjustment, MonocularObservationsConvergeToNoiseLevel) {
 TEST(LocalBundleAdjustment, FlagsOutlierObservations) {
   BaScene scene = make_scene(6, 2, 300, 0.7, 0.1, 14);
   const PinholeCamera camera = test_camera();
-  const BaResult result = solve_bundle_adjustment(scene.problem, camera, test_bf(camera));
+  const BaResult result =
+      solve_bundle_adjustment(scene.problem, camera, test_bf(camera), u_r_model_options());
   int outliers = 0, flagged = 0, inliers = 0, kept = 0;
   for (size_t i = 0; i < scene.is_outlier.size(); ++i) {
     if (scene.is_outlier[i]) {
@@ -206,7 +215,8 @@ TEST(LocalBundleAdjustment, AllKeyframesFixedOptimisesPointsOnly) {
   BaScene scene = make_scene(4, 4, 200, 1.0, 0.0, 15);
   const BaProblem start = scene.problem;
   const PinholeCamera camera = test_camera();
-  const BaResult result = solve_bundle_adjustment(scene.problem, camera, test_bf(camera));
+  const BaResult result =
+      solve_bundle_adjustment(scene.problem, camera, test_bf(camera), u_r_model_options());
   for (size_t k = 0; k < 4; ++k) {
     EXPECT_TRUE(
         scene.problem.keyframes[k].T_camera_world.isApprox(start.keyframes[k].T_camera_world, 0.0));

@@ -130,16 +130,18 @@ TEST(ReprojectionError, DisparityRowUsesTheDepthNoiseModel) {
   const Eigen::Vector3d point(0.1, -0.2, 2.0);
   const double u = camera.fx * point.x() / point.z() + camera.cx;
   const double v = camera.fy * point.y() / point.z() + camera.cy;
-  // Measured 5 mm further than the point: σ_z(2 m) = 1.2 mm + 1.9 mm · 1.6² = 6.064 mm.
+  // Measured 5 mm further than the point; σ_z at the measured depth.
   const double z_measured = 2.005;
+  const double sigma_z = 0.0012 + 0.0019 * (z_measured - 0.4) * (z_measured - 0.4);
   const Measurement<3> measured(u, v, u - bf / z_measured);
   Eigen::Vector3d r;
   ASSERT_TRUE(whitened_residual<3>(model, measured, 1.0, point, r, nullptr));
   EXPECT_NEAR(r(0), 0.0, 1e-9);
   EXPECT_NEAR(r(1), 0.0, 1e-9);
-  const double sigma_d = bf * 0.006064 / (z_measured * z_measured);
-  EXPECT_NEAR(r(2), (bf / z_measured - bf / point.z()) / sigma_d, 1e-3);
-  EXPECT_NEAR(r(2), -0.005 / 0.006064, 2e-3);  // ≈ the depth error in σ_z units
+  const double sigma_d = bf * sigma_z / (z_measured * z_measured);
+  EXPECT_NEAR(r(2), (bf / z_measured - bf / point.z()) / sigma_d, 1e-9);
+  // ≈ the depth error in σ_z units (−0.82), where the u_r row would say −0.026 σ.
+  EXPECT_NEAR(r(2), -0.005 * z_measured / (point.z() * sigma_z), 1e-9);
 }
 
 TEST(ReprojectionError, HuberWeightedJacobiansAreScaledDerivatives) {

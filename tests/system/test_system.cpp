@@ -4,9 +4,17 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/eval/ate.h"
@@ -100,10 +108,10 @@ TEST(RunCommand, WritesEveryOutputForASyntheticSequence) {
   SynthOptions options = static_room(30);
   write_sequence(options, dir / "sequence");
   std::string output;
-  const int status =
-      testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
-                             (dir / "sequence").string() + " --out " + (dir / "out").string(),
-                         &output);
+  const int status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
+                                            (dir / "sequence").string() + " --dynamic off --out " +
+                                            (dir / "out").string(),
+                                        &output);
   ASSERT_EQ(status, 0) << output;
   EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory.txt"), 30);
   EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory_refined.txt"), 30);
@@ -131,7 +139,7 @@ TEST(RunCommand, TracksTheStaticStretchOfBonnCrowd) {
       testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
                              (shared / "data" / "bonn_crowd_dev").string() + " --config " +
                              (source_dir() / "config" / "bonn.yaml").string() +
-                             " --max-frames 200 --out " + (dir / "out").string(),
+                             " --max-frames 200 --dynamic off --out " + (dir / "out").string(),
                          &output);
   ASSERT_EQ(status, 0) << output;
   EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory.txt"), 200);
@@ -140,6 +148,96 @@ TEST(RunCommand, TracksTheStaticStretchOfBonnCrowd) {
       read_tum_trajectory(shared / "data" / "bonn_crowd_dev" / "groundtruth.txt");
   const AteResult ate = compute_ate(ground_truth, estimate);
   EXPECT_LT(ate.error.rmse, 0.05) << output;
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Ctrl-C in the middle of `pspslam run`: the loop stops, the run still ends cleanly with status
+// 130, a parsable trajectory and a complete stats.json. The default mode (full: semantic thread
+// + geometry) runs, so the semantic thread must shut down on the way out too.
+TEST(RunCommand, InterruptWritesTrajectoryAndStats) {
+  const std::filesystem::path dir = testing::make_temp_dir("run_sigint");
+  SynthOptions options = static_room(60);
+  options.bodies = 2;
+  write_sequence(options, dir / "sequence");
+  const std::filesystem::path out = dir / "out";
+  const std::string log = (dir / "run.log").string();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string sequence = (dir / "sequence").string();
+    const std::string out_dir = out.string();
+    std::freopen(log.c_str(), "w", stdout);
+    std::freopen(log.c_str(), "a", stderr);
+    execl(PSPSLAM_CLI_PATH, PSPSLAM_CLI_PATH, "run", "--sequence", sequence.c_str(), "--out",
+          out_dir.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until a few poses were written (generous: the machine may be loaded).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  while (std::chrono::steady_clock::now() < deadline &&
+         count_pose_lines(out / "trajectory.txt") < 5) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_GE(count_pose_lines(out / "trajectory.txt"), 5) << read_text(log);
+  ASSERT_EQ(kill(child, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << read_text(log);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << read_text(log);
+
+  const Trajectory trajectory = read_tum_trajectory(out / "trajectory.txt");
+  EXPECT_GE(trajectory.size(), 5u);
+  EXPECT_LT(trajectory.size(), 60u) << "the run was not interrupted";
+  const std::string stats = read_text(out / "stats.json");
+  for (const char* key :
+       {"\"frames\"", "\"lost_frames\"", "\"fps\"", "\"timing_ms\"", "\"extraction\"",
+        "\"semantic\"", "\"geometry\"", "\"tracking\"", "\"local_mapping\"", "\"median\"",
+        "\"p95\"", "\"dynamic\"", "\"tested_points\"", "\"dynamic_points\"", "\"masked_keypoints\"",
+        "\"mode\": \"full\"", "\"interrupted\": true"}) {
+    EXPECT_NE(stats.find(key), std::string::npos) << key << " missing in\n" << stats;
+  }
+  // Valid JSON: python3 is part of the development image (Debian 12).
+  std::string output;
+  EXPECT_EQ(testing::run_shell("python3 -m json.tool " + (out / "stats.json").string(), &output), 0)
+      << output;
+}
+
+// Geometry-only mode on the synthetic dynamic sequence of the benchmark (300 frames, 3 people,
+// one carrying a box, seed 1): the multi-view test must find the people and the run must stay
+// as accurate as on the static twin (measured 0.011 m both, bench/results/modes.csv). Plain
+// SLAM (`off`) is not compared here: whether it survives this sequence depends on the core's
+// outlier handling, which changed while this was written (0.235 m -> 0.006 m; see the report).
+// Geometry-only keeps the segmentation network's run time out of the test.
+TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSequence) {
+  const std::filesystem::path dir = testing::make_temp_dir("run_dynamic_geometry");
+  SynthOptions options = static_room(300);
+  options.bodies = 3;
+  options.threads = 0;
+  write_sequence(options, dir / "sequence");
+  std::string output;
+  const int status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
+                                            (dir / "sequence").string() +
+                                            " --dynamic geometry --out " + (dir / "out").string(),
+                                        &output);
+  ASSERT_EQ(status, 0) << output;
+  const double ate = compute_ate(read_tum_trajectory(dir / "sequence" / "groundtruth.txt"),
+                                 read_tum_trajectory(dir / "out" / "trajectory.txt"))
+                         .error.rmse;
+  EXPECT_LT(ate, 0.02) << output;
+  const std::string stats = read_text(dir / "out" / "stats.json");
+  const auto total = [&](const std::string& key) {
+    const size_t at = stats.find("\"" + key + "\": ");
+    return at == std::string::npos ? -1L : std::stol(stats.substr(at + key.size() + 4));
+  };
+  EXPECT_GT(total("tested_points"), 10000) << stats;
+  EXPECT_GT(total("dynamic_points"), 500) << stats;  // people and the box were found
+  EXPECT_GT(total("masked_keypoints"), 500) << stats;
 }
 
 }  // namespace

@@ -6,11 +6,16 @@ namespace pspslam {
 
 const char* to_string(DynamicMode mode) {
   switch (mode) {
-    case DynamicMode::off: return "off";
-    case DynamicMode::semantic: return "semantic";
-    case DynamicMode::geometry: return "geometry";
-    case DynamicMode::full: return "full";
-    case DynamicMode::exhaustive: return "exhaustive";
+    case DynamicMode::off:
+      return "off";
+    case DynamicMode::semantic:
+      return "semantic";
+    case DynamicMode::geometry:
+      return "geometry";
+    case DynamicMode::full:
+      return "full";
+    case DynamicMode::exhaustive:
+      return "exhaustive";
   }
   return "?";
 }

@@ -34,9 +34,9 @@ class HomographyChain {
 };
 
 struct WarpedMask {
-  cv::Mat mask;             // CV_8UC1 in the current frame, empty when none could be made
-  int age_frames = 0;       // current frame id - the mask's frame id
-  bool warped = false;      // false: the mask is the current frame's own (or copied unwarped)
+  cv::Mat mask;         // CV_8UC1 in the current frame, empty when none could be made
+  int age_frames = 0;   // current frame id - the mask's frame id
+  bool warped = false;  // false: the mask is the current frame's own (or copied unwarped)
 };
 
 // Brings `mask` (computed for frame `mask_frame_id`) into frame `current_id` through `chain`

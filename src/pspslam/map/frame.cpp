@@ -1,5 +1,7 @@
 #include "pspslam/map/frame.h"
 
+#include <limits>
+
 #include "pspslam/map/map_point.h"
 
 namespace pspslam {
@@ -15,7 +17,7 @@ Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> ke
       pyramid_(std::move(pyramid)) {
   const size_t n = keypoints_.size();
   depth_.assign(n, -1.0f);
-  right_u_.assign(n, -1.0f);
+  right_u_.assign(n, std::numeric_limits<float>::quiet_NaN());
   // Depth is registered to the distorted image: read it before undistorting.
   const bool has_depth = !depth_metres.empty();
   for (size_t i = 0; i < n; ++i) {

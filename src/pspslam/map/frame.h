@@ -34,9 +34,12 @@ class Frame {
   const std::vector<cv::KeyPoint>& keypoints() const { return keypoints_; }
   const cv::Mat& descriptors() const { return descriptors_; }
   const std::uint8_t* descriptor(int i) const { return descriptors_.ptr<std::uint8_t>(i); }
-  // Depth in metres (<= 0: no valid reading) and virtual right coordinate (< 0: none).
+  // Depth in metres (<= 0: no valid reading) and virtual right coordinate u − bf/z (NaN without
+  // depth: a real u_r is negative for close points near the left border, so no sign can mean
+  // "none"). Test has_depth(i), never the sign of right_u(i).
   float depth(int i) const { return depth_[i]; }
   float right_u(int i) const { return right_u_[i]; }
+  bool has_depth(int i) const { return depth_[i] > 0.0f; }
   const std::vector<float>& depths() const { return depth_; }
   const std::vector<float>& right_us() const { return right_u_; }
   const RgbdCamera& camera() const { return *camera_; }

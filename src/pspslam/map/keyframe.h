@@ -45,7 +45,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const cv::Mat& descriptors() const { return descriptors_; }
   const std::uint8_t* descriptor(int i) const { return descriptors_.ptr<std::uint8_t>(i); }
   float depth(int i) const { return depth_[i]; }
-  float right_u(int i) const { return right_u_[i]; }
+  float right_u(int i) const { return right_u_[i]; }  // NaN without depth (see Frame)
+  bool has_depth(int i) const { return depth_[i] > 0.0f; }
   const RgbdCamera& camera() const { return *camera_; }
   const ScalePyramid& pyramid() const { return *pyramid_; }
   void features_in_area(double x, double y, double radius, int min_level, int max_level,

@@ -29,6 +29,11 @@ void Map::erase_map_point(const std::shared_ptr<MapPoint>& point) {
   map_points_.erase(point->id());
 }
 
+size_t Map::erase_bad_map_points() {
+  std::lock_guard lock(mutex_);
+  return std::erase_if(map_points_, [](const auto& entry) { return entry.second->is_bad(); });
+}
+
 std::shared_ptr<KeyFrame> Map::keyframe(std::uint64_t id) const {
   std::lock_guard lock(mutex_);
   auto it = keyframes_.find(id);

@@ -29,6 +29,10 @@ class Map {
   // Marks bad (detaching from the graph) and drops the map's ownership.
   void erase_keyframe(const std::shared_ptr<KeyFrame>& keyframe);
   void erase_map_point(const std::shared_ptr<MapPoint>& point);
+  // Drops the map's ownership of every point that became bad without passing through
+  // erase_map_point (MapPoint::erase_observation or replace_with can make a point bad from
+  // anywhere). Returns how many were dropped. O(points); local mapping runs it per keyframe.
+  size_t erase_bad_map_points();
 
   std::shared_ptr<KeyFrame> keyframe(std::uint64_t id) const;  // nullptr if erased
   std::vector<std::shared_ptr<KeyFrame>> keyframes() const;    // ordered by id

@@ -54,7 +54,7 @@ void MapPoint::add_observation(const std::shared_ptr<KeyFrame>& keyframe, int ke
   std::lock_guard lock(observation_mutex_);
   if (observations_.contains(keyframe->id())) return;
   observations_[keyframe->id()] = {keyframe, keypoint_index};
-  num_observations_ += keyframe->right_u(keypoint_index) >= 0.0f ? 2 : 1;
+  num_observations_ += keyframe->has_depth(keypoint_index) ? 2 : 1;
 }
 
 bool MapPoint::erase_observation(std::uint64_t keyframe_id) {
@@ -64,7 +64,7 @@ bool MapPoint::erase_observation(std::uint64_t keyframe_id) {
     auto it = observations_.find(keyframe_id);
     if (it == observations_.end()) return false;
     if (auto kf = it->second.keyframe.lock()) {
-      num_observations_ -= kf->right_u(it->second.keypoint_index) >= 0.0f ? 2 : 1;
+      num_observations_ -= kf->has_depth(it->second.keypoint_index) ? 2 : 1;
     } else {
       num_observations_ -= 1;
     }

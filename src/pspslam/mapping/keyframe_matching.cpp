@@ -41,9 +41,8 @@ double keypoint_chi_squared(const KeyFrame& keyframe, int index,
   const double du = keypoint.pt.x - projected.x();
   const double dv = keypoint.pt.y - projected.y();
   double squared = du * du + dv * dv;
-  const float right_u = keyframe.right_u(index);
-  if (right_u >= 0.0f) {
-    const double dr = right_u - (projected.x() - camera.bf / point_camera.z());
+  if (keyframe.has_depth(index)) {
+    const double dr = keyframe.right_u(index) - (projected.x() - camera.bf / point_camera.z());
     squared += dr * dr;
   }
   return squared * keyframe.pyramid().inv_sigma2[keypoint.octave];
@@ -77,7 +76,7 @@ std::vector<KeypointMatch> search_for_triangulation(const KeyFrame& first, const
     const Eigen::Vector3d line = F21 * Eigen::Vector3d(p1.x, p1.y, 1.0);
     const double line_norm2 = line.x() * line.x() + line.y() * line.y();
     if (line_norm2 <= 0.0) continue;
-    const bool depth1 = first.right_u(i1) >= 0.0f;
+    const bool depth1 = first.has_depth(i1);
     int best_distance = max_descriptor_distance + 1;
     int best_index = -1;
     for (const int i2 : free2) {
@@ -88,7 +87,7 @@ std::vector<KeypointMatch> search_for_triangulation(const KeyFrame& first, const
       if (distance_to_line * distance_to_line >= 3.84 * sigma2[keypoint2.octave] * line_norm2) {
         continue;
       }
-      if (!depth1 && second.right_u(i2) < 0.0f) {
+      if (!depth1 && !second.has_depth(i2)) {
         const double ex = epipole.x() - keypoint2.pt.x;
         const double ey = epipole.y() - keypoint2.pt.y;
         if (ex * ex + ey * ey < 100.0 * scale[keypoint2.octave]) continue;
@@ -134,7 +133,7 @@ int fuse_into_keyframe(Map& map, const std::shared_ptr<KeyFrame>& keyframe,
     int best_distance = INT_MAX;
     int best_index = -1;
     for (const int index : candidates) {
-      const double threshold = keyframe->right_u(index) >= 0.0f ? 7.8 : 5.99;
+      const double threshold = keyframe->has_depth(index) ? 7.8 : 5.99;
       if (keypoint_chi_squared(*keyframe, index, point_camera) > threshold) continue;
       const int d = descriptor_distance(descriptor, keyframe->descriptor(index));
       if (d < best_distance) {

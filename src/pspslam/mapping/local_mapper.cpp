@@ -45,6 +45,9 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
     stats_.keyframes_culled += cull_redundant_keyframes(*map_, keyframe, options_);
   }
 
+  // Points made bad as a side effect (an observation erased, a duplicate replaced) would
+  // otherwise stay owned by the Map forever.
+  stats_.bad_points_swept += map_->erase_bad_map_points();
   ++stats_.keyframes_processed;
   stats_.last_keyframe_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

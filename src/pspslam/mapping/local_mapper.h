@@ -19,6 +19,7 @@ struct LocalMappingStats {
   std::uint64_t points_from_depth = 0;
   std::uint64_t points_triangulated = 0;
   std::uint64_t points_culled = 0;
+  std::uint64_t bad_points_swept = 0;  // bad points found still in the Map (erase_bad_map_points)
   std::uint64_t points_fused = 0;
   std::uint64_t keyframes_culled = 0;
   std::uint64_t bundle_adjustments = 0;

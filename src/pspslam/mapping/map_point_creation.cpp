@@ -63,15 +63,14 @@ bool reprojects(const KeyFrame& keyframe, int index, const Pose& T_camera_world,
   const double du = keypoint.pt.x - pixel.x();
   const double dv = keypoint.pt.y - pixel.y();
   const double sigma2 = keyframe.pyramid().sigma2[keypoint.octave];
-  const float right_u = keyframe.right_u(index);
-  if (right_u < 0.0f) return du * du + dv * dv <= 5.991 * sigma2;
-  const double dr = right_u - (pixel.x() - camera.bf / point_camera.z());
+  if (!keyframe.has_depth(index)) return du * du + dv * dv <= 5.991 * sigma2;
+  const double dr = keyframe.right_u(index) - (pixel.x() - camera.bf / point_camera.z());
   return du * du + dv * dv + dr * dr <= 7.8 * sigma2;
 }
 
 // Parallax that a depth reading offers: the angle the virtual baseline subtends at that depth.
 double depth_parallax_cos(const KeyFrame& keyframe, int index) {
-  if (keyframe.right_u(index) < 0.0f) return 2.0;  // no depth: any ray parallax beats it
+  if (!keyframe.has_depth(index)) return 2.0;  // no depth: any ray parallax beats it
   return std::cos(2.0 * std::atan2(keyframe.camera().baseline() / 2.0, keyframe.depth(index)));
 }
 

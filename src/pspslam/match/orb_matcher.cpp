@@ -106,7 +106,7 @@ int search_by_projection(Frame& frame, const std::vector<ProjectedPoint>& projec
     for (int i : candidates) {
       if (frame.map_points[i] && frame.map_points[i]->num_observations() > 0) continue;
       // With depth, the virtual right coordinate must agree too (ORB-SLAM2 stereo check).
-      if (frame.right_u(i) > 0.0f) {
+      if (frame.has_depth(i)) {
         const double error = std::abs(p.right_u - frame.right_u(i));
         if (error > radius * pyramid.scale[level]) continue;
       }
@@ -177,7 +177,7 @@ int search_previous_frame(Frame& current, const Frame& previous, double radius,
     int best_index = -1;
     for (int i : candidates) {
       if (current.map_points[i] && current.map_points[i]->num_observations() > 0) continue;
-      if (current.right_u(i) > 0.0f && std::abs(right_u - current.right_u(i)) > window) continue;
+      if (current.has_depth(i) && std::abs(right_u - current.right_u(i)) > window) continue;
       const int distance = descriptor_distance(descriptor, current.descriptor(i));
       if (distance < best_distance) {
         best_distance = distance;

@@ -18,7 +18,7 @@ namespace pspslam {
 // depth, so the weight is fixed for an observation. Disabled, the ORB-SLAM2 u_r row is used.
 struct DepthNoiseModel {
   bool enabled = true;
-  double constant = 0.0012;  // metres
+  double constant = 0.0012;   // metres
   double quadratic = 0.0019;  // metres per square metre
   double offset = 0.4;        // metres
   // Multiplies σ_d: margin for depth/colour registration and depth sampled at the rounded pixel.

@@ -20,7 +20,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool has_depth(const BaObservation& observation) { return observation.right_u >= 0.0; }
+bool has_depth(const BaObservation& observation) { return !std::isnan(observation.right_u); }
 
 void check_indices(const BaProblem& problem) {
   for (size_t i = 0; i < problem.observations.size(); ++i) {

@@ -13,7 +13,7 @@ namespace pspslam {
 
 namespace {
 
-bool has_depth(const PoseObservation& observation) { return observation.right_u >= 0.0; }
+bool has_depth(const PoseObservation& observation) { return !std::isnan(observation.right_u); }
 
 double observation_chi_squared(const StereoProjection& model, const PoseObservation& observation,
                                const Pose& T_camera_world) {

@@ -41,8 +41,11 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <deque>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <vector>
 
 #include "pspslam/dynamic/frame_flow.h"
 #include "pspslam/dynamic/keypoint_fusion.h"
@@ -53,9 +56,9 @@
 #include "pspslam/map/frame.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
+#include "pspslam/map/map_point.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
-#include "pspslam/map/map_point.h"
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/semantic/onnx_segmenter.h"
 #include "pspslam/semantic/semantic_thread.h"
@@ -144,7 +147,6 @@ class System::MappingConnection final : public KeyFrameSink {
   LocalMappingStats last_;
 };
 
-
 // The dynamic-scene stages around tracking and their state between frames (steps 1, 2, 4, 6 of
 // the layout above). Owns the semantic thread; everything else runs on the caller's thread.
 class System::DynamicPipeline {
@@ -155,8 +157,7 @@ class System::DynamicPipeline {
     if (options.mode == DynamicMode::full) geometry.search.strategy = SearchStrategy::ant_colony;
     if (options.mode == DynamicMode::exhaustive)
       geometry.search.strategy = SearchStrategy::exhaustive;
-    if (uses_geometry(options.mode))
-      geometry_ = std::make_unique<GeometryStage>(camera, geometry);
+    if (uses_geometry(options.mode)) geometry_ = std::make_unique<GeometryStage>(camera, geometry);
     if (uses_semantics(options.mode)) {
       SemanticParams params = options.semantic;
       // Deterministic mode announces one frame ahead: two may be pending and none may be
@@ -263,8 +264,8 @@ class System::DynamicPipeline {
       last_pose_id_ = current_id_;
       if (!previous_mask_.empty()) {
         const auto points = map_.reference_map_points();
-        const auto& culled = culler_.observe(points, *result.T_world_camera, previous_mask_,
-                                             depth, camera_);
+        const auto& culled =
+            culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
         if (!culled.empty()) {
           std::lock_guard lock(map_.update_mutex());
           for (const auto& point : culled) map_.erase_map_point(point);
@@ -301,7 +302,8 @@ class System::DynamicPipeline {
     report.mask_warped = warped.warped;
     report.semantic_inference_ms = result->inference_ms;
     for (const Submitted& submitted : submitted_) {
-      if (submitted.id == result->frame_id) report.mask_latency_ms = milliseconds_since(submitted.time);
+      if (submitted.id == result->frame_id)
+        report.mask_latency_ms = milliseconds_since(submitted.time);
     }
     return warped.mask;
   }

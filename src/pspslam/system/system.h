@@ -2,12 +2,9 @@
 
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
-#include <optional>
-#include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
@@ -61,11 +58,11 @@ struct DynamicReport {
   int mask_age_frames = -1;          // current frame - the mask's frame; -1: no mask
   double mask_latency_ms = 0.0;      // from submitting the mask's frame until its use here
   bool mask_warped = false;
-  bool geometry_ran = false;         // false without a pose prior or reference keyframes
-  int tested_points = 0;             // multi-view tests run
-  int dynamic_points = 0;            // keypoints geometry flagged (tested or in grown regions)
-  int masked_keypoints = 0;          // extracted keypoints dropped as dynamic before tracking
-  int culled_map_points = 0;         // map points erased for lying on dynamic pixels
+  bool geometry_ran = false;  // false without a pose prior or reference keyframes
+  int tested_points = 0;      // multi-view tests run
+  int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
+  int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
+  int culled_map_points = 0;  // map points erased for lying on dynamic pixels
 };
 
 // One frame through the system: the tracking result and where the time went.

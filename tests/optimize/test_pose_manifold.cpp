@@ -125,7 +125,7 @@ TEST(ReprojectionError, RgbdJacobiansMatchFiniteDifferences) {
 TEST(ReprojectionError, DisparityRowUsesTheDepthNoiseModel) {
   const PinholeCamera camera = testing::test_camera();
   const double bf = testing::test_bf(camera);
-  const DepthNoiseModel depth_noise;  // enabled by default
+  const DepthNoiseModel depth_noise{.enabled = true};
   const StereoProjection model = StereoProjection::from(camera, bf, depth_noise);
   const Eigen::Vector3d point(0.1, -0.2, 2.0);
   const double u = camera.fx * point.x() / point.z() + camera.cx;

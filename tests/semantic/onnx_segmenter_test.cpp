@@ -75,16 +75,20 @@ TEST(OnnxSegmenter, LabelMapHasTheImageSizeAndDynamicClassesFromMetadata) {
 
 TEST(OnnxSegmenter, OutputShapeDisagreeingWithMetadataIsAnError) {
   SegmenterMetadata meta = load_segmenter_metadata(kModelDir / "pspnet.yaml");
-  meta.output_stride = 8;
+  ASSERT_EQ(meta.output_stride, 1);
+  meta.output_stride = 8;  // the network really outputs logits at the input size
   OnnxSegmenter segmenter(meta);
+  const int w = meta.input_width;
+  const int h = meta.input_height;
   try {
-    segmenter.segment(cv::Mat(288, 384, CV_8UC3, cv::Scalar::all(0)));
+    segmenter.segment(cv::Mat(h, w, CV_8UC3, cv::Scalar::all(0)));
     FAIL() << "expected an Error";
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()),
-              (kModelDir / "pspnet.yaml").string() +
-                  ": network output is 1x21x288x384, metadata says 1x21x36x48 (classes, input / "
-                  "output.stride)");
+              (kModelDir / "pspnet.yaml").string() + ": network output is 1x21x" +
+                  std::to_string(h) + "x" + std::to_string(w) + ", metadata says 1x21x" +
+                  std::to_string(h / 8) + "x" + std::to_string(w / 8) +
+                  " (classes, input / output.stride)");
   }
 }
 

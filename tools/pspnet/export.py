@@ -69,6 +69,16 @@ def write_teacher_yamls():
         (out / f"{name}.yaml").write_text(text)
 
 
+def reference(model, blob):
+    """PyTorch logits of the model as trained (plain dilated convolutions)."""
+    phase = model.backbone.phase_layout
+    model.backbone.phase_layout = False
+    with torch.no_grad():
+        out = model(torch.from_numpy(blob)).numpy()
+    model.backbone.phase_layout = phase
+    return out
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -89,9 +99,12 @@ def main():
     state = torch.load(args.checkpoint, map_location="cpu")
     hw = (args.height, args.width)
     model = PSPNet(hw, state["width_multiplier"], state["branch_channels"],
-                   state["head_channels"])
+                   state["head_channels"], last_dilation=state.get("last_dilation", 4))
     model.load_state_dict(state["model"])
     model.eval()
+    # Same function, faster graph for OpenCV 4.6 where the phase rows are wide enough.
+    model.backbone.phase_layout = model.backbone.phase_layout_pays((args.height // 8, args.width // 8))
+    print(f"space-to-batch layout for the dilated stages: {model.backbone.phase_layout}")
 
     onnx_name = f"pspnet_{args.width}x{args.height}.onnx"
     onnx_path = common.MODEL_DIR / onnx_name
@@ -112,8 +125,7 @@ def main():
     worst = 0.0
     for label, bgr in inputs:
         blob = common.to_blob(bgr, args.width, args.height)
-        with torch.no_grad():
-            ref = model(torch.from_numpy(blob)).numpy()
+        ref = reference(model, blob)
         net.setInput(blob)
         out = net.forward()
         diff = float(np.abs(out - ref).max())
@@ -137,9 +149,8 @@ def main():
         cv2.imwrite(str(golden / "input.png"), image)
         # Re-read: the test feeds the PNG, so the logits must be of the decoded pixels.
         image = cv2.imread(str(golden / "input.png"))
-        with torch.no_grad():  # the reference is PyTorch's output, not OpenCV's
-            logits = model(torch.from_numpy(common.to_blob(image, args.width,
-                                                           args.height)))[0].numpy()
+        # The reference is PyTorch's output, not OpenCV's.
+        logits = reference(model, common.to_blob(image, args.width, args.height))[0]
         cv2.imwrite(str(golden / "labels.png"), logits.argmax(0).astype(np.uint8))
         rng = np.random.default_rng(3)
         lines = []

@@ -59,9 +59,37 @@ class InvertedResidual(nn.Module):
         self.body = nn.Sequential(*layers)
         self.residual = stride == 1 and cin == cout
 
-    def forward(self, x):
-        y = self.body(x)
+        self.dilation = dilation
+
+    def forward(self, x, phase_layout=False):
+        """phase_layout: x holds the dilation-rate phases of the feature map as
+        batch entries (space-to-batch), so the depthwise conv runs undilated."""
+        if not phase_layout or self.dilation == 1:
+            y = self.body(x)
+        else:
+            expand, depthwise, project = self.body[:-2], self.body[-2], self.body[-1]
+            conv = depthwise[0]
+            y = F.relu6(F.conv2d(expand(x), conv.weight, conv.bias, conv.stride, 1, 1,
+                                 conv.groups))
+            y = project(y)
         return x + y if self.residual else y
+
+
+def space_to_batch(x, rate):
+    """(1, C, H, W) -> (rate*rate, C, H/rate, W/rate): batch entry (py, px) holds pixels
+    (py + rate*i, px + rate*j).  A 3x3 convolution with dilation `rate` on x equals an
+    undilated 3x3 convolution on each entry, zero padding included.  5-D shapes: OpenCV
+    4.6 permutes them faster than 6-D ones."""
+    _, c, h, w = x.shape
+    x = x.reshape(c, h // rate, rate, w // rate, rate)
+    return x.permute(2, 4, 0, 1, 3).reshape(rate * rate, c, h // rate, w // rate)
+
+
+def batch_to_space(x, rate):
+    """Inverse of space_to_batch."""
+    _, c, h, w = x.shape
+    x = x.reshape(rate, rate, c, h, w)
+    return x.permute(2, 3, 0, 4, 1).reshape(1, c, h * rate, w * rate)
 
 
 class DilatedMobileNetV2(nn.Module):
@@ -72,20 +100,47 @@ class DilatedMobileNetV2(nn.Module):
     transposes cost more in OpenCV than they saved, so plain dilation it is.)
     """
 
-    def __init__(self, width="1.0"):
+    def __init__(self, width="1.0", last_dilation=4):
         super().__init__()
         widths = WIDTHS[width]
         self.out_channels = widths[-1]
         layers = [conv_relu6(3, widths[0], 3, stride=2)]
         cin = widths[0]
         for (t, _, n, s, d), c in zip(STAGES, widths[1:]):
+            d = last_dilation if d == 4 else d
             for i in range(n):
                 layers.append(InvertedResidual(cin, c, t, s if i == 0 else 1, d))
                 cin = c
         self.features = nn.Sequential(*layers)
 
+        # Export switch: run the dilated stages in space-to-batch layout, converting once
+        # per change of dilation rate (OpenCV 4.6 has a fast path for undilated 3x3
+        # depthwise convolutions only; dilated ones cost ~6x more).
+        self.phase_layout = False
+
     def forward(self, x):
-        return self.features(x)
+        if not self.phase_layout:
+            return self.features(x)
+        rate = 1  # dilation rate of the phase split x is in
+        for layer in self.features:
+            d = layer.dilation if isinstance(layer, InvertedResidual) else 1
+            if d != rate:
+                x = batch_to_space(x, rate) if rate > 1 else x
+                x = space_to_batch(x, d) if d > 1 else x
+                rate = d
+            x = layer(x, True) if isinstance(layer, InvertedResidual) else layer(x)
+        return batch_to_space(x, rate) if rate > 1 else x
+
+    def phase_layout_pays(self, feat_hw):
+        """OpenCV 4.6's fast 3x3 depthwise path needs rows of >= 18 outputs (measured:
+        18 and 24 fast, 16 and 12 slow); only then is the phase layout worth its two
+        transposes.  One dilation rate only, dividing the feature map."""
+        rates = {m.dilation for m in self.features if isinstance(m, InvertedResidual)} - {1}
+        if len(rates) != 1:
+            return False
+        rate = rates.pop()
+        h, w = feat_hw
+        return h % rate == 0 and w % rate == 0 and w // rate >= 18
 
     def convs(self):
         """All Conv2d layers in graph order (matches the DeepLab ONNX order)."""
@@ -127,13 +182,13 @@ class PyramidPooling(nn.Module):
 class PSPNet(nn.Module):
     # Defaults = the shipped model (width 0.5, 4 x 32 pyramid channels, 64 head channels).
     def __init__(self, input_hw=(288, 384), width="0.5", branch_channels=32,
-                 head_channels=64, num_classes=NUM_CLASSES, dropout=0.1):
+                 head_channels=64, num_classes=NUM_CLASSES, dropout=0.1, last_dilation=4):
         super().__init__()
         h, w = input_hw
         if h % 8 or w % 8:
             raise ValueError("input size must divide by 8")
         self.input_hw = input_hw
-        self.backbone = DilatedMobileNetV2(width)
+        self.backbone = DilatedMobileNetV2(width, last_dilation)
         cin = self.backbone.out_channels
         self.ppm = PyramidPooling(cin, branch_channels, (h // 8, w // 8))
         self.head = nn.Sequential(

@@ -19,11 +19,32 @@ import numpy as np
 import common
 
 
+class OrtNet:
+    """cv2.dnn-like wrapper over onnxruntime, for OpenCV builds that cannot read a teacher."""
+
+    def __init__(self, path):
+        import onnxruntime  # optional: only where cv2.dnn fails
+
+        self.session = onnxruntime.InferenceSession(path, providers=["CPUExecutionProvider"])
+        self.blob = None
+
+    def setInput(self, blob):  # noqa: N802 (cv2.dnn's name)
+        self.blob = blob
+
+    def forward(self):
+        name = self.session.get_inputs()[0].name
+        return self.session.run(None, {name: self.blob})[0]
+
+
 def teacher_nets(names):
     nets = []
     for name in names:
         spec = common.TEACHERS[name]
-        net = cv2.dnn.readNetFromONNX(str(common.SHARED / "models" / spec["onnx"]))
+        path = str(common.SHARED / "models" / spec["onnx"])
+        try:
+            net = cv2.dnn.readNetFromONNX(path)
+        except cv2.error:
+            net = OrtNet(path)
         nets.append((name, spec, net))
     return nets
 
@@ -55,10 +76,11 @@ def main():
     parser.add_argument("--teachers", nargs="+",
                         default=["deeplabv3_mnv2_pascal"],
                         help="teacher names (see common.TEACHERS)")
+    parser.add_argument("--threads", type=int, default=2, help="OpenCV threads")
     parser.add_argument("--out", default=str(common.WORK / "cache.npz"), help="output file")
     args = parser.parse_args()
 
-    cv2.setNumThreads(2)
+    cv2.setNumThreads(args.threads)
     split = common.make_split(args.seed)
     nets = teacher_nets(args.teachers)
     samples = [("human_seg", i) for i in split["train"]]

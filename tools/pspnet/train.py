@@ -46,58 +46,75 @@ def load_backbone_from_onnx(model, onnx_path):
 
 
 class Augmenter:
-    """Random scale, crop, flip and colour jitter applied identically to image,
-    mask and teacher log-probabilities."""
+    """Random scale (0.6-1.5 of the network input), crop (or placement with grey
+    padding), horizontal flip and colour jitter, done as one affine resampling per sample
+    on the training device; the same geometry is applied to the image, the person mask
+    and the teachers' log-probabilities.  Padding is marked invalid (ignored by the loss)."""
 
-    def __init__(self, cache, out_hw, rng, scale=(0.6, 1.5)):
-        self.images, self.masks, self.soft = cache["images"], cache["masks"], cache["soft"]
+    def __init__(self, cache, out_hw, device, generator, scale=(0.6, 1.5)):
         self.out_h, self.out_w = out_hw
-        self.rng = rng
+        self.device = device
+        self.gen = generator
         self.scale = scale
+        images = torch.from_numpy(cache["images"]).permute(0, 3, 1, 2)  # N x 3 x H x W BGR
+        # Pre-shrink (antialiased) to 1.5x the input so that bilinear sampling does not alias.
+        if images.shape[-1] > 1.5 * self.out_w:
+            size = (int(round(1.5 * self.out_h)), int(round(1.5 * self.out_w)))
+            images = torch.cat([F.interpolate(images[i:i + 32].float(), size=size,
+                                              mode="bilinear", align_corners=False,
+                                              antialias=True).round().clamp(0, 255).byte()
+                                for i in range(0, len(images), 32)])
+        self.images = images.to(device)
+        self.masks = torch.from_numpy(cache["masks"])[:, None].to(device)
+        self.soft = torch.from_numpy(cache["soft"]).to(device)
 
-    def sample(self, k):
-        rng = self.rng
-        s = rng.uniform(*self.scale)
-        w, h = int(round(self.out_w * s)), int(round(self.out_h * s))
-        img = cv2.resize(self.images[k], (w, h), interpolation=cv2.INTER_LINEAR)
-        mask = cv2.resize(self.masks[k], (w, h), interpolation=cv2.INTER_NEAREST)
-        soft = cv2.resize(self.soft[k].astype(np.float32).transpose(1, 2, 0), (w, h),
-                          interpolation=cv2.INTER_LINEAR)
-        valid = np.ones((h, w), np.uint8)
-        # Pad to at least the crop size.
-        ph, pw = max(0, self.out_h - h), max(0, self.out_w - w)
-        if ph or pw:
-            img = cv2.copyMakeBorder(img, 0, ph, 0, pw, cv2.BORDER_CONSTANT, value=(128,) * 3)
-            mask = cv2.copyMakeBorder(mask, 0, ph, 0, pw, cv2.BORDER_CONSTANT, value=254)
-            soft = np.pad(soft, ((0, ph), (0, pw), (0, 0)))
-            valid = cv2.copyMakeBorder(valid, 0, ph, 0, pw, cv2.BORDER_CONSTANT, value=0)
-        y = rng.randint(0, img.shape[0] - self.out_h)
-        x = rng.randint(0, img.shape[1] - self.out_w)
-        sl = (slice(y, y + self.out_h), slice(x, x + self.out_w))
-        img, mask, soft, valid = img[sl], mask[sl], soft[sl], valid[sl]
-        if rng.random() < 0.5:
-            img, mask, soft, valid = img[:, ::-1], mask[:, ::-1], soft[:, ::-1], valid[:, ::-1]
-        img = self.jitter(img)
-        return (np.ascontiguousarray(img), np.ascontiguousarray(mask),
-                np.ascontiguousarray(soft.transpose(2, 0, 1)), np.ascontiguousarray(valid))
+    def rand(self, n, lo, hi):
+        return lo + (hi - lo) * torch.rand(n, generator=self.gen)
+
+    def batch(self, idx, mean, std):
+        n = len(idx)
+        s = self.rand(n, *self.scale)
+        flip = torch.where(torch.rand(n, generator=self.gen) < 0.5, -1.0, 1.0)
+        # Offset of the crop in the rescaled image (pixels), uniform over the valid range
+        # (negative when the rescaled image is smaller than the input: grey padding).
+        off = []
+        for out in (self.out_w, self.out_h):
+            extra = out * s - out
+            off.append(torch.minimum(extra, torch.zeros(n)) + self.rand(n, 0, 1) * extra.abs())
+        # Normalised output coordinate -> normalised source coordinate; a flip mirrors
+        # the sampling around the crop's centre.
+        theta = torch.zeros(n, 2, 3)
+        theta[:, 0, 0] = flip / s
+        theta[:, 0, 2] = (self.out_w + 2 * off[0]) / (self.out_w * s) - 1
+        theta[:, 1, 1] = 1 / s
+        theta[:, 1, 2] = (self.out_h + 2 * off[1]) / (self.out_h * s) - 1
+        shape = (n, 1, self.out_h, self.out_w)
+        grid = F.affine_grid(theta.to(self.device), shape, align_corners=False)
+        idx_t = torch.as_tensor(idx, device=self.device)
+        img = F.grid_sample(self.images[idx_t].float(), grid, mode="bilinear",
+                            padding_mode="border", align_corners=False)
+        valid = F.grid_sample(torch.ones(shape, device=self.device), grid, mode="nearest",
+                              padding_mode="zeros", align_corners=False)[:, 0] > 0.5
+        mask = F.grid_sample(self.masks[idx_t].float(), grid, mode="nearest",
+                             padding_mode="border", align_corners=False)[:, 0].long()
+        soft = F.grid_sample(self.soft[idx_t].float(), grid, mode="bilinear",
+                             padding_mode="border", align_corners=False)
+        rgb = self.jitter(img).flip(1)  # BGR -> RGB
+        mean_t = torch.tensor(mean, device=self.device).view(1, 3, 1, 1)
+        std_t = torch.tensor(std, device=self.device).view(1, 3, 1, 1)
+        x = (rgb - mean_t) / std_t * valid[:, None]  # padding = the mean (grey)
+        mask[~valid] = 254
+        return x, mask, soft, valid
 
     def jitter(self, img):
-        rng = self.rng
-        f = img.astype(np.float32)
-        f = f * rng.uniform(0.7, 1.3) + rng.uniform(-25, 25)  # contrast, brightness
-        gray = f.mean(axis=2, keepdims=True)
-        f = gray + (f - gray) * rng.uniform(0.6, 1.4)  # saturation
-        return np.clip(f, 0, 255).astype(np.uint8)
-
-
-def batch_tensors(samples, mean, std):
-    imgs = np.stack([s[0] for s in samples])[:, :, :, ::-1].astype(np.float32)
-    imgs = (imgs - np.float32(mean)) / np.float32(std)
-    x = torch.from_numpy(np.ascontiguousarray(imgs.transpose(0, 3, 1, 2)))
-    mask = torch.from_numpy(np.stack([s[1] for s in samples]).astype(np.int64))
-    soft = torch.from_numpy(np.stack([s[2] for s in samples]))
-    valid = torch.from_numpy(np.stack([s[3] for s in samples]).astype(bool))
-    return x, mask, soft, valid
+        n = img.shape[0]
+        view = (n, 1, 1, 1)
+        contrast = self.rand(n, 0.7, 1.3).view(view).to(self.device)
+        bright = self.rand(n, -25, 25).view(view).to(self.device)
+        sat = self.rand(n, 0.6, 1.4).view(view).to(self.device)
+        f = img * contrast + bright
+        gray = f.mean(1, keepdim=True)
+        return (gray + (f - gray) * sat).clamp(0, 255)
 
 
 def hard_labels(mask, soft, valid):
@@ -112,19 +129,29 @@ def hard_labels(mask, soft, valid):
     return labels, has_gt
 
 
-def evaluate(model, ids, hw, mean, std):
-    model.eval()
-    ious = []
-    with torch.no_grad():
+class Validator:
+    """Person IoU over the validation photos with the C++ path's preprocessing (stretch to
+    the input with bilinear resize, arg-max, nearest-neighbour resize to the photo)."""
+
+    def __init__(self, ids, hw, mean, std):
+        self.hw = hw
+        self.samples = []
         for sample_id in ids:
             bgr, gt = common.load_human_seg(sample_id)
-            x = torch.from_numpy(common.to_blob(bgr, hw[1], hw[0], mean, std))
-            labels = model(x)[0].argmax(0).numpy().astype(np.uint8)
-            labels = cv2.resize(labels, (gt.shape[1], gt.shape[0]),
-                                interpolation=cv2.INTER_NEAREST)
-            ious.append(common.person_iou(labels, gt))
-    model.train()
-    return float(np.mean(ious))
+            self.samples.append((torch.from_numpy(common.to_blob(bgr, hw[1], hw[0], mean, std)),
+                                 gt))
+
+    def __call__(self, model, device):
+        model.eval()
+        ious = []
+        with torch.no_grad():
+            for blob, gt in self.samples:
+                labels = model(blob.to(device))[0].argmax(0).byte().cpu().numpy()
+                labels = cv2.resize(labels, (gt.shape[1], gt.shape[0]),
+                                    interpolation=cv2.INTER_NEAREST)
+                ious.append(common.person_iou(labels, gt))
+        model.train()
+        return float(np.mean(ious))
 
 
 def main():
@@ -136,46 +163,70 @@ def main():
                         help="DeepLab v3 MobileNetV2 ONNX to initialise the backbone from")
     parser.add_argument("--width-multiplier", default="0.5", choices=["0.5", "1.0"],
                         help="MobileNetV2 width (must match --init)")
+    parser.add_argument("--last-dilation", type=int, default=2, choices=[2, 4],
+                        help="dilation of the 160/320 stages (2: every dilated stage has rate 2, "
+                             "which the export runs undilated in space-to-batch layout)")
+    parser.add_argument("--branch-channels", type=int, default=32, help="PPM branch channels")
+    parser.add_argument("--head-channels", type=int, default=64, help="3x3 head conv channels")
     parser.add_argument("--input-width", type=int, default=384, help="training/shipping width")
     parser.add_argument("--input-height", type=int, default=288, help="training/shipping height")
-    parser.add_argument("--epochs", type=int, default=2, help="epochs")
+    parser.add_argument("--epochs", type=int, default=2, help="epochs (cosine schedule over them)")
     parser.add_argument("--batch", type=int, default=8, help="batch size")
     parser.add_argument("--lr", type=float, default=1e-3, help="head learning rate (AdamW)")
     parser.add_argument("--backbone-lr", type=float, default=3e-4, help="backbone learning rate")
     parser.add_argument("--temperature", type=float, default=2.0, help="distillation temperature")
     parser.add_argument("--kd-weight", type=float, default=1.0, help="distillation loss weight")
+    parser.add_argument("--gt-weight", type=float, default=1.0,
+                        help="CE weight of pixels with a ground-truth person mask")
+    parser.add_argument("--iou-weight", type=float, default=0.0,
+                        help="weight of a soft-Jaccard person loss on ground-truth photos")
     parser.add_argument("--pseudo-weight", type=float, default=0.5,
                         help="CE weight of teacher arg-max labels on frames without GT")
     parser.add_argument("--seed", type=int, default=5, help="random seed")
     parser.add_argument("--threads", type=int, default=2, help="torch CPU threads")
+    parser.add_argument("--device", default="auto", help="auto (CUDA if present), cpu, cuda")
+    parser.add_argument("--eval-every", type=int, default=1, help="validate every N epochs")
+    parser.add_argument("--fit-minutes", type=float, default=0.0,
+                        help="if > 0: after the first epoch, lower --epochs so that the run "
+                             "takes about this long (the cosine schedule then spans them)")
     parser.add_argument("--max-minutes", type=float, default=45.0,
                         help="stop after the epoch that passes this wall time")
     parser.add_argument("--initial-eval", action="store_true",
-                        help="also log the validation IoU before training (0.1632 for the "
-                             "default setting: random head)")
+                        help="also log the validation IoU before training")
     parser.add_argument("--out", default=str(common.WORK / "pspnet.pt"), help="checkpoint")
     parser.add_argument("--log", default=str(common.MODEL_DIR / "training_log.txt"),
                         help="per-epoch log file")
     args = parser.parse_args()
 
+    if args.device == "auto":
+        args.device = "cuda" if torch.cuda.is_available() else "cpu"
+    device = torch.device(args.device)
     torch.set_num_threads(args.threads)
     cv2.setNumThreads(1)
     torch.manual_seed(args.seed)
     np.random.seed(args.seed)
     rng = random.Random(args.seed)
-    torch.use_deterministic_algorithms(True)
+    gen = torch.Generator().manual_seed(args.seed)
+    # CUDA has no deterministic kernel for some backward passes (bilinear upsampling):
+    # there the run is seeded but not bit-reproducible.
+    torch.use_deterministic_algorithms(True, warn_only=device.type == "cuda")
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = False
 
     hw = (args.input_height, args.input_width)
     cache = dict(np.load(args.cache))
     kinds = list(cache["kinds"])
     split = common.load_split()
-    model = PSPNet(hw, args.width_multiplier, branch_channels=32, head_channels=64)
+    model = PSPNet(hw, args.width_multiplier, branch_channels=args.branch_channels,
+                   head_channels=args.head_channels, last_dilation=args.last_dilation)
     n_init = load_backbone_from_onnx(model, args.init)
+    model.to(device)
     backbone, head = model.param_groups()
     opt = torch.optim.AdamW([{"params": backbone, "lr": args.backbone_lr},
                              {"params": head, "lr": args.lr}], weight_decay=1e-4)
     base_lrs = [args.backbone_lr, args.lr]
-    aug = Augmenter(cache, hw, rng)
+    aug = Augmenter(cache, hw, device, gen)
+    validate = Validator(split["val"], hw, common.MEAN, common.STD)
     n = len(kinds)
     steps_per_epoch = n // args.batch
     total_steps = steps_per_epoch * args.epochs
@@ -190,7 +241,10 @@ def main():
         log.write(text + "\n")
         log.flush()
 
-    say(f"# pspnet training started {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}")
+    say(f"# pspnet training started {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())} "
+        f"on {device.type}"
+        + (f" ({torch.cuda.get_device_name(device)})" if device.type == "cuda" else "")
+        + f", torch {torch.__version__}")
     say(f"# args {json.dumps(vars(args))}")
     say(f"# data: {kinds.count('human_seg')} human_seg train photos (split seed "
         f"{split['seed']}, {len(split['val'])} validation photos never trained on), "
@@ -199,22 +253,20 @@ def main():
     say(f"# backbone initialised from {Path(args.init).name} ({n_init} conv layers); "
         f"params {sum(p.numel() for p in model.parameters())}")
     if args.initial_eval:
-        iou0 = evaluate(model, split["val"], hw, common.MEAN, common.STD)
-        say(f"epoch 0 val_person_iou {iou0:.4f}")
+        say(f"epoch 0 val_person_iou {validate(model, device):.4f}")
     start = time.time()
     step = 0
     T = args.temperature
-    best = -1.0
+    best, iou = -1.0, float("nan")
     for epoch in range(1, args.epochs + 1):
         order = list(range(n))
         rng.shuffle(order)
-        sums = {"loss": 0.0, "ce": 0.0, "kd": 0.0}
+        sums = {"loss": 0.0, "ce": 0.0, "kd": 0.0, "iou": 0.0}
         epoch_start = time.time()
         model.train()
         for b in range(steps_per_epoch):
             idx = order[b * args.batch:(b + 1) * args.batch]
-            x, mask, soft, valid = batch_tensors([aug.sample(k) for k in idx], common.MEAN,
-                                                 common.STD)
+            x, mask, soft, valid = aug.batch(idx, common.MEAN, common.STD)
             labels, has_gt = hard_labels(mask, soft, valid)
             factor = (step + 1) / warmup if step < warmup else 0.5 * (
                 1 + math.cos(math.pi * (step - warmup) / max(1, total_steps - warmup)))
@@ -222,13 +274,23 @@ def main():
                 group["lr"] = lr * factor
             logits = model(x)
             ce_map = F.cross_entropy(logits, labels, ignore_index=IGNORE, reduction="none")
-            weight = torch.where(has_gt, 1.0, args.pseudo_weight) * valid
+            weight = torch.where(has_gt, args.gt_weight, args.pseudo_weight) * valid
             ce = (ce_map * weight).sum() / weight.sum().clamp(min=1)
             log_p = F.log_softmax(logits / T, 1)
             q = F.softmax(soft / T, 1)
             kd_map = (q * (torch.log(q.clamp(min=1e-8)) - log_p)).sum(1)
             kd = (kd_map * valid).sum() / valid.sum().clamp(min=1) * T * T
             loss = ce + args.kd_weight * kd
+            soft_iou_loss = torch.zeros((), device=device)
+            gt_photo = (has_gt & valid).flatten(1).any(1)
+            if args.iou_weight > 0 and gt_photo.any():
+                # Soft Jaccard of the person probability against the GT mask, per photo.
+                p = F.softmax(logits, 1)[:, PERSON] * valid
+                g = ((mask == 255) & valid).float()
+                inter = (p * g).flatten(1).sum(1)
+                union = (p + g - p * g).flatten(1).sum(1).clamp(min=1)
+                soft_iou_loss = (1 - inter / union)[gt_photo].mean()
+                loss = loss + args.iou_weight * soft_iou_loss
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -236,24 +298,35 @@ def main():
             sums["loss"] += loss.item()
             sums["ce"] += ce.item()
             sums["kd"] += kd.item()
-            if b % 5 == 4:
-                print(f"  epoch {epoch} step {b + 1}/{steps_per_epoch} loss {loss.item():.3f} "
-                      f"{time.time() - epoch_start:.0f}s", flush=True)
-        iou = evaluate(model, split["val"], hw, common.MEAN, common.STD)
+            sums["iou"] += soft_iou_loss.item()
         m = {k: v / steps_per_epoch for k, v in sums.items()}
+        if epoch == 1 and args.fit_minutes > 0:
+            fit = max(2, int(args.fit_minutes * 60 / (time.time() - epoch_start)))
+            if fit < args.epochs:
+                args.epochs = fit
+                total_steps = steps_per_epoch * args.epochs
+                say(f"# --fit-minutes {args.fit_minutes}: training {args.epochs} epochs")
+        last = epoch == args.epochs or (time.time() - start) / 60 > args.max_minutes
+        text = ""
+        if epoch % args.eval_every == 0 or last:
+            iou = validate(model, device)
+            best = max(best, iou)
+            text = f" val_person_iou {iou:.4f}"
         say(f"epoch {epoch} loss {m['loss']:.4f} ce {m['ce']:.4f} kd {m['kd']:.4f} "
-            f"val_person_iou {iou:.4f} epoch_s {time.time() - epoch_start:.0f} "
+            f"soft_iou_loss {m['iou']:.4f}{text} epoch_s {time.time() - epoch_start:.1f} "
             f"total_s {time.time() - start:.0f}")
-        state = {"model": model.state_dict(), "epoch": epoch, "val_iou": iou,
-                 "width_multiplier": args.width_multiplier, "branch_channels": 32,
-                 "head_channels": 64, "input_hw": hw, "args": vars(args)}
-        torch.save(state, args.out)  # the last epoch is the shipped one
-        best = max(best, iou)
-        if (time.time() - start) / 60 > args.max_minutes and epoch < args.epochs:
-            say(f"# stopped after epoch {epoch}: time limit {args.max_minutes} min reached")
+        if last:
+            if epoch < args.epochs:
+                say(f"# stopped after epoch {epoch}: time limit {args.max_minutes} min reached")
             break
+    state = {"model": {k: v.cpu() for k, v in model.state_dict().items()}, "epoch": epoch,
+             "val_iou": iou, "width_multiplier": args.width_multiplier,
+             "branch_channels": args.branch_channels, "head_channels": args.head_channels,
+             "last_dilation": args.last_dilation, "input_hw": hw, "args": vars(args)}
+    torch.save(state, args.out)  # the last epoch is the shipped one
     say(f"# finished {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}; shipped the last "
-        f"epoch (val IoU {iou:.4f}); best epoch val IoU {best:.4f} (not used for selection)")
+        f"epoch (val IoU {iou:.4f}); best validated epoch IoU {best:.4f} (not used for "
+        f"selection)")
     log.close()
 
 

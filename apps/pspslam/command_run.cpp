@@ -133,6 +133,12 @@ int run_command(const std::vector<std::string>& args) {
                     "feed frames at the sequence's rate (late frames are dropped) and never wait "
                     "for segmentation: use the newest mask, warped into the frame");
   parser.add_option("mask-margin", "dilation of the semantic dynamic mask (pixels)", "5");
+  parser.add_option("vocabulary",
+                    "ORB bag-of-words vocabulary for relocalisation (relative: to the source "
+                    "directory)",
+                    "models/vocabulary/orb_k10_l5.pspvoc");
+  parser.add_switch("no-relocalization",
+                    "do not relocalise when tracking is lost (and do not load the vocabulary)");
   parser.add_option("cull-hits",
                     "erase a map point after it lay on dynamic pixels in this many frames", "3");
   if (!parser.parse(args)) return 0;
@@ -178,6 +184,10 @@ int run_command(const std::vector<std::string>& args) {
             << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
             << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
             << "\n";
+  system_options.place.relocalization = !parser.flag("no-relocalization");
+  system_options.place.vocabulary = parser.get("vocabulary");
+  if (system_options.place.vocabulary.is_relative())
+    system_options.place.vocabulary = source_dir() / system_options.place.vocabulary;
   System system(setup.config, system_options);
   InterruptGuard interrupt_guard;
   ProgressBar progress("slam", frames, std::cerr);

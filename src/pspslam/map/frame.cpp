@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "pspslam/map/map_point.h"
+#include "pspslam/place/vocabulary.h"
 
 namespace pspslam {
 
@@ -53,6 +54,12 @@ Eigen::Vector3d Frame::unproject_camera(int i) const {
 
 Eigen::Vector3d Frame::unproject_world(int i) const {
   return T_camera_world_->inverse() * unproject_camera(i);
+}
+
+void Frame::compute_bow(const Vocabulary& vocabulary, int direct_index_level) {
+  if (has_bow_) return;
+  vocabulary.transform(descriptors_, bow_, features_, direct_index_level);
+  has_bow_ = true;
 }
 
 }  // namespace pspslam

@@ -10,10 +10,12 @@
 #include "pspslam/map/feature_grid.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
+#include "pspslam/place/bow_vector.h"
 
 namespace pspslam {
 
 class MapPoint;
+class Vocabulary;
 
 // One tracked image: undistorted keypoints with their depth, descriptors and the map points
 // that tracking associates with them. A Frame is transient and owned by tracking; it shares
@@ -66,6 +68,13 @@ class Frame {
   Eigen::Vector3d unproject_camera(int i) const;
   Eigen::Vector3d unproject_world(int i) const;
 
+  // Bag of words, computed only when needed (relocalisation of a lost frame): a tracked frame
+  // never pays for it. Computed once; later calls return at once.
+  void compute_bow(const Vocabulary& vocabulary, int direct_index_level);
+  bool has_bow() const { return has_bow_; }
+  const BowVector& bow_vector() const { return bow_; }
+  const FeatureVector& feature_vector() const { return features_; }
+
   // Association of keypoint i with a map point (nullptr: none) and its outlier flag.
   std::vector<std::shared_ptr<MapPoint>> map_points;
   std::vector<std::uint8_t> outlier;
@@ -81,6 +90,9 @@ class Frame {
   std::shared_ptr<const ScalePyramid> pyramid_;
   FeatureGrid grid_;
   std::optional<Pose> T_camera_world_;
+  bool has_bow_ = false;
+  BowVector bow_;
+  FeatureVector features_;
 };
 
 }  // namespace pspslam

@@ -4,6 +4,7 @@
 
 #include "pspslam/map/frame.h"
 #include "pspslam/map/map_point.h"
+#include "pspslam/place/vocabulary.h"
 
 namespace pspslam {
 namespace {
@@ -30,6 +31,13 @@ KeyFrame::KeyFrame(std::uint64_t id, const Frame& frame)
   for (size_t i = 0; i < keypoints_.size(); ++i) {
     if (frame.map_points[i] && !frame.outlier[i]) map_points_[i] = frame.map_points[i];
   }
+}
+
+void KeyFrame::compute_bow(const Vocabulary& vocabulary, int direct_index_level) {
+  std::lock_guard lock(bow_mutex_);
+  if (bow_ready_.load(std::memory_order_relaxed)) return;
+  vocabulary.transform(descriptors_, bow_, features_, direct_index_level);
+  bow_ready_.store(true, std::memory_order_release);
 }
 
 Pose KeyFrame::T_camera_world() const {

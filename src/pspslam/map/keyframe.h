@@ -13,11 +13,13 @@
 #include "pspslam/map/feature_grid.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
+#include "pspslam/place/bow_vector.h"
 
 namespace pspslam {
 
 class Frame;
 class MapPoint;
+class Vocabulary;
 
 // A frame kept in the map. Owned by Map; everything it refers to (its map points, covisible
 // keyframes, spanning-tree parent and children) is held by weak_ptr, so the Map stays the only
@@ -56,6 +58,17 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   Eigen::Vector3d unproject_world(int i) const;  // needs depth(i) > 0
   // Median depth of its map points in this camera (for baseline checks in mapping).
   double median_scene_depth() const;
+
+  // --- bag of words (thread-safe). Computed once, by local mapping (off the tracking thread),
+  // before the keyframe enters the KeyFrameDatabase; immutable afterwards, so a keyframe found
+  // through the database can be read without a lock.
+  // Idempotent: a second call (any vocabulary) keeps the first result.
+  void compute_bow(const Vocabulary& vocabulary, int direct_index_level);
+  bool has_bow() const { return bow_ready_.load(std::memory_order_acquire); }
+  // Empty until has_bow(). The feature vector is the direct index at direct_index_level
+  // (keypoint indices grouped by vocabulary node) for guided matching.
+  const BowVector& bow_vector() const { return has_bow() ? bow_ : no_bow_; }
+  const FeatureVector& feature_vector() const { return has_bow() ? features_ : no_features_; }
 
   // --- map point associations (thread-safe)
   void add_map_point(int index, const std::shared_ptr<MapPoint>& point);
@@ -117,6 +130,13 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const std::shared_ptr<const RgbdCamera> camera_;
   const std::shared_ptr<const ScalePyramid> pyramid_;
   const FeatureGrid grid_;
+
+  std::mutex bow_mutex_;  // serialises compute_bow; readers use bow_ready_
+  std::atomic<bool> bow_ready_{false};
+  BowVector bow_;
+  FeatureVector features_;
+  const BowVector no_bow_;
+  const FeatureVector no_features_;
 
   mutable std::mutex pose_mutex_;
   Pose T_camera_world_;

@@ -36,7 +36,8 @@ bool is_redundant(const KeyFrame& candidate, const LocalMappingOptions& options)
 }  // namespace
 
 int cull_redundant_keyframes(Map& map, const std::shared_ptr<KeyFrame>& keyframe,
-                             const LocalMappingOptions& options) {
+                             const LocalMappingOptions& options,
+                             const std::function<void(std::uint64_t)>& on_erased) {
   int culled = 0;
   for (const auto& candidate : keyframe->covisibles()) {
     if (candidate->id() == 0 || candidate->is_bad()) continue;
@@ -45,6 +46,7 @@ int cull_redundant_keyframes(Map& map, const std::shared_ptr<KeyFrame>& keyframe
     map.erase_keyframe(candidate);
     if (!candidate->is_bad()) continue;
     ++culled;
+    if (on_erased) on_erased(candidate->id());
     // Points left with too few observations turned bad; they must leave the map as well.
     for (const auto& point : points) {
       if (point && point->is_bad()) map.erase_map_point(point);

@@ -10,11 +10,13 @@
 #include "pspslam/mapping/keyframe_matching.h"
 #include "pspslam/mapping/local_bundle_adjuster.h"
 #include "pspslam/mapping/map_point_creation.h"
+#include "pspslam/place/place_recognition.h"
 
 namespace pspslam {
 
-LocalMapper::LocalMapper(std::shared_ptr<Map> map, LocalMappingOptions options)
-    : map_(std::move(map)), options_(std::move(options)) {}
+LocalMapper::LocalMapper(std::shared_ptr<Map> map, LocalMappingOptions options,
+                         std::shared_ptr<PlaceRecognition> place)
+    : map_(std::move(map)), options_(std::move(options)), place_(std::move(place)) {}
 
 void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
                           const std::function<bool()>& has_new_keyframe) {
@@ -22,6 +24,12 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
   const auto keyframe_waiting = [&] { return has_new_keyframe && has_new_keyframe(); };
 
   insert_keyframe_into_map(keyframe);
+  if (place_ && !keyframe->is_bad()) {
+    // Here rather than in tracking (ORB-SLAM2 ProcessNewKeyFrame): the ~1 ms tree descent per
+    // keyframe stays off the tracking thread.
+    keyframe->compute_bow(place_->vocabulary(), place_->direct_index_level());
+    place_->database().add(keyframe->id(), keyframe->bow_vector());
+  }
   cull_recent_points(*keyframe);
   const auto triangulated =
       create_points_by_triangulation(*map_, keyframe, options_, has_new_keyframe);
@@ -42,7 +50,10 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
     stats_.last_bundle_adjustment_seconds = report.seconds;
   }
   if (!keyframe_waiting() && options_.cull_keyframes) {
-    stats_.keyframes_culled += cull_redundant_keyframes(*map_, keyframe, options_);
+    const auto forget = [this](std::uint64_t id) {
+      if (place_) place_->database().erase(id);
+    };
+    stats_.keyframes_culled += cull_redundant_keyframes(*map_, keyframe, options_, forget);
   }
 
   // Points made bad as a side effect (an observation erased, a duplicate replaced) would

@@ -12,6 +12,7 @@ namespace pspslam {
 class KeyFrame;
 class Map;
 class MapPoint;
+class PlaceRecognition;
 
 // Counters for monitoring and tests (cumulative since construction).
 struct LocalMappingStats {
@@ -37,9 +38,12 @@ struct LocalMappingStats {
 //   3. triangulate new points with the covisible keyframes
 //   4. fuse duplicates with first and second neighbours        (skipped if a keyframe waits)
 //   5. local bundle adjustment, 6. redundant keyframe culling  (skipped if a keyframe waits)
+// With `place` (may be null) each keyframe gets its bag of words in step 1 and enters the
+// keyframe database; culled keyframes leave it.
 class LocalMapper {
  public:
-  LocalMapper(std::shared_ptr<Map> map, LocalMappingOptions options);
+  LocalMapper(std::shared_ptr<Map> map, LocalMappingOptions options,
+              std::shared_ptr<PlaceRecognition> place = nullptr);
 
   // has_new_keyframe is polled between steps and inside bundle adjustment; when it returns
   // true the optional steps are skipped / the BA stops early, so tracking never waits long.
@@ -58,6 +62,7 @@ class LocalMapper {
 
   std::shared_ptr<Map> map_;
   LocalMappingOptions options_;
+  std::shared_ptr<PlaceRecognition> place_;
   // Weak: the Map stays the only owner; a point erased elsewhere just drops out of probation.
   std::vector<std::weak_ptr<MapPoint>> recent_points_;
   LocalMappingStats stats_;

@@ -5,8 +5,9 @@
 
 namespace pspslam {
 
-LocalMapping::LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options)
-    : mapper_(std::move(map), std::move(options)),
+LocalMapping::LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options,
+                           std::shared_ptr<PlaceRecognition> place)
+    : mapper_(std::move(map), std::move(options), std::move(place)),
       thread_([this](const std::stop_token& stop) { run(stop); }) {}
 
 LocalMapping::~LocalMapping() {

@@ -40,10 +40,14 @@ namespace pspslam {
 
 class KeyFrame;
 class Map;
+class PlaceRecognition;
 
 class LocalMapping {
  public:
-  explicit LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options = {});
+  // `place` (may be null): vocabulary + keyframe database that processed keyframes are added to
+  // (see LocalMapper).
+  explicit LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options = {},
+                        std::shared_ptr<PlaceRecognition> place = nullptr);
   LocalMapping(std::shared_ptr<Map> map, const SystemConfig& config)
       : LocalMapping(std::move(map), LocalMappingOptions::from_config(config)) {}
   ~LocalMapping();  // stops the worker (interrupting a BA) and joins it

@@ -60,6 +60,7 @@
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/mapping/local_mapping.h"
+#include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/onnx_segmenter.h"
 #include "pspslam/semantic/semantic_thread.h"
 #include "pspslam/tracking/keyframe_sink.h"
@@ -85,11 +86,18 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 // run statistics that LocalMapping does not (queue high-water mark, BA time).
 class System::MappingConnection final : public KeyFrameSink {
  public:
-  explicit MappingConnection(std::unique_ptr<LocalMapping> mapping)
-      : mapping_(std::move(mapping)) {}
+  MappingConnection(std::unique_ptr<LocalMapping> mapping, std::shared_ptr<PlaceRecognition> place)
+      : mapping_(std::move(mapping)), place_(std::move(place)) {}
 
   void insert_keyframe(std::shared_ptr<KeyFrame> keyframe) override {
-    if (!mapping_) return;
+    if (!mapping_) {
+      // No local mapping to index the keyframe: do it here so relocalisation still works.
+      if (place_) {
+        keyframe->compute_bow(place_->vocabulary(), place_->direct_index_level());
+        place_->database().add(keyframe->id(), keyframe->bow_vector());
+      }
+      return;
+    }
     mapping_->insert_keyframe(std::move(keyframe));
     std::lock_guard lock(mutex_);
     max_queue_ = std::max(max_queue_, mapping_->queue_size());
@@ -139,6 +147,7 @@ class System::MappingConnection final : public KeyFrameSink {
   }
 
   std::unique_ptr<LocalMapping> mapping_;
+  std::shared_ptr<PlaceRecognition> place_;  // indexes keyframes itself when mapping_ is null
   std::mutex mutex_;
   size_t max_queue_ = 0;
   size_t processed_ = 0;
@@ -350,13 +359,18 @@ System::System(const SystemConfig& config, SystemOptions options)
       pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
       extractor_(std::make_unique<OrbExtractor>(config.orb)),
       map_(std::make_shared<Map>()) {
+  if (options.place.needs_vocabulary()) {
+    const std::filesystem::path vocabulary =
+        options.place.vocabulary.empty() ? default_vocabulary_path() : options.place.vocabulary;
+    place_ = PlaceRecognition::load(vocabulary);
+  }
   std::unique_ptr<LocalMapping> mapping;
   if (options.local_mapping) {
     LocalMappingOptions mapping_options;
     mapping_options.close_depth = config.camera.depth_threshold;
-    mapping = std::make_unique<LocalMapping>(map_, mapping_options);
+    mapping = std::make_unique<LocalMapping>(map_, mapping_options, place_);
   }
-  mapping_ = std::make_unique<MappingConnection>(std::move(mapping));
+  mapping_ = std::make_unique<MappingConnection>(std::move(mapping), place_);
   // ORB-SLAM2 wants a keyframe at least once per second of video.
   options.tracker.keyframes.max_frames_between = static_cast<int>(config.camera.fps);
   tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker);

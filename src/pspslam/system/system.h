@@ -19,6 +19,7 @@ namespace pspslam {
 class LocalMapping;
 class Map;
 class OrbExtractor;
+class PlaceRecognition;
 struct RgbdFrame;
 struct RgbdCamera;
 struct ScalePyramid;
@@ -39,6 +40,19 @@ struct DynamicOptions {
   std::chrono::milliseconds semantic_timeout{30000};
 };
 
+// Place recognition (issue #4): bag-of-words vocabulary and keyframe database.
+struct PlaceOptions {
+  // Vocabulary file (`pspslam run --vocabulary`); empty = default_vocabulary_path()
+  // (models/vocabulary/orb_k10_l5.pspvoc in the source tree).
+  std::filesystem::path vocabulary;
+  // Relocalise a lost tracker against the keyframe database. Needs the vocabulary, which is
+  // then loaded (~0.1 s) and every keyframe gets a BoW vector in local mapping.
+  bool relocalization = true;
+
+  // True when anything needs the vocabulary (relocalisation; loop closing joins here).
+  bool needs_vocabulary() const { return relocalization; }
+};
+
 struct SystemOptions {
   // ORB-SLAM2's virtual stereo baseline for RGB-D (u_r = u - fx * b / z), metres.
   double virtual_baseline = 0.08;
@@ -46,6 +60,7 @@ struct SystemOptions {
   // false: keyframes go into the map but no local mapping runs (tests, debugging).
   bool local_mapping = true;
   DynamicOptions dynamic;
+  PlaceOptions place;
 };
 
 // What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
@@ -126,6 +141,8 @@ class System {
   MappingStats mapping_stats() const;
   const DynamicOptions& dynamic_options() const { return dynamic_options_; }
   const Map& map() const { return *map_; }
+  // Vocabulary + keyframe database; null when PlaceOptions needs no vocabulary.
+  const std::shared_ptr<PlaceRecognition>& place_recognition() const { return place_; }
 
  private:
   class MappingConnection;
@@ -136,6 +153,8 @@ class System {
   std::unique_ptr<OrbExtractor> extractor_;
   // Shared with the local mapping thread, which needs the map for as long as it runs.
   std::shared_ptr<Map> map_;
+  // Shared with local mapping (indexes keyframes) and tracking (relocalisation queries).
+  std::shared_ptr<PlaceRecognition> place_;
   // Declared before tracker_ so it is destroyed after it (the tracker points to it).
   std::unique_ptr<MappingConnection> mapping_;
   std::unique_ptr<Tracker> tracker_;

@@ -47,15 +47,20 @@ const char* to_string(TrackingMethod method) {
       return "reference_keyframe";
     case TrackingMethod::kRecovery:
       return "recovery";
+    case TrackingMethod::kRelocalisation:
+      return "relocalisation";
   }
   return "?";
 }
 
-Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options)
+Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
+                 std::shared_ptr<PlaceRecognition> place)
     : map_(map),
       sink_(sink),
       options_(std::move(options)),
-      local_map_(options_.max_local_keyframes) {}
+      local_map_(options_.max_local_keyframes) {
+  if (place) relocalizer_ = std::make_unique<Relocalizer>(map_, std::move(place), options_.relocalizer);
+}
 
 TrackResult Tracker::track(Frame frame) {
   std::lock_guard map_lock(map_.update_mutex());
@@ -77,6 +82,10 @@ TrackResult Tracker::track(Frame frame) {
     if (state_ == TrackingState::kOk && velocity_ && last_frame_ && last_frame_->has_pose()) {
       ok = track_with_motion_model(frame);
       if (ok) result.method = TrackingMethod::kMotionModel;
+    }
+    if (!ok && state_ == TrackingState::kLost && relocalizer_) {
+      ok = relocalize(frame);
+      if (ok) result.method = TrackingMethod::kRelocalisation;
     }
     if (!ok) {
       const bool recovering = state_ == TrackingState::kLost;
@@ -135,6 +144,22 @@ Trajectory Tracker::refined_trajectory() const {
     trajectory.push_back({anchor.timestamp, T_camera_world.inverse()});
   }
   return trajectory;
+}
+
+void Tracker::on_map_corrected() {
+  if (anchors_.empty()) return;
+  const FrameAnchor& anchor = anchors_.back();
+  const auto reference = anchor.reference.lock();
+  if (!reference || reference->is_bad()) return;
+  const Pose corrected = orthonormalized(anchor.T_camera_reference * reference->T_camera_world());
+  // The velocity is relative (T_current_last) and stays valid under a rigid correction.
+  last_tracked_pose_ = corrected;
+  if (last_frame_ && last_frame_->has_pose()) last_frame_->set_pose(corrected);
+}
+
+std::optional<Pose> Tracker::last_tracked_world_pose() const {
+  if (!last_tracked_pose_) return std::nullopt;
+  return last_tracked_pose_->inverse();
 }
 
 bool Tracker::initialize(Frame& frame) {
@@ -246,6 +271,14 @@ bool Tracker::track_reference_keyframe(Frame& frame, bool recovering) {
   frame.set_pose(initial);
   optimize_frame_pose(frame);
   return discard_outliers(frame) >= options_.min_pose_inliers;
+}
+
+bool Tracker::relocalize(Frame& frame) {
+  const RelocalizationResult relocalized = relocalizer_->relocalize(frame);
+  if (!relocalized.success) return false;
+  reference_keyframe_ = relocalized.keyframe;
+  last_recovery_frame_id_ = frame.id();
+  return true;
 }
 
 bool Tracker::track_local_map(Frame& frame) {

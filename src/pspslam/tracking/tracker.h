@@ -11,12 +11,14 @@
 #include "pspslam/optimize/pose_optimizer.h"
 #include "pspslam/tracking/keyframe_policy.h"
 #include "pspslam/tracking/local_map.h"
+#include "pspslam/tracking/relocalizer.h"
 
 namespace pspslam {
 
 class KeyFrame;
 class KeyFrameSink;
 class Map;
+class PlaceRecognition;
 
 struct TrackerOptions {
   int min_initial_depth_points = 500;  // keypoints with depth needed to start the map
@@ -31,12 +33,22 @@ struct TrackerOptions {
   KeyFramePolicyOptions keyframes;
   MatcherOptions matcher;
   PoseOptimizerOptions pose_optimizer;
+  RelocalizerOptions relocalizer;
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
 
 // How the frame's pose was first estimated before local map tracking refined it.
-enum class TrackingMethod { kNone, kInitialization, kMotionModel, kReferenceKeyFrame, kRecovery };
+// kRelocalisation: BoW relocalisation against the whole map (lost frames, with a vocabulary);
+// kRecovery: the older fallback against the last reference keyframe when that fails.
+enum class TrackingMethod {
+  kNone,
+  kInitialization,
+  kMotionModel,
+  kReferenceKeyFrame,
+  kRecovery,
+  kRelocalisation
+};
 
 const char* to_string(TrackingState state);
 const char* to_string(TrackingMethod method);
@@ -56,15 +68,19 @@ struct TrackResult {
 // Tracking of each frame (ORB-SLAM2 RGB-D semantics): map initialisation from the first frame
 // with enough depth, constant-velocity motion model, reference-keyframe fallback, local map
 // tracking, keyframe decision. When tracking fails the frame is reported lost and the next
-// frames try again against the reference keyframe (with PnP-RANSAC from the matches, since
-// the last pose may be stale); no new map is started, so all poses stay in one world frame.
+// frames are relocalised against the whole map through the keyframe database (Relocalizer,
+// when a PlaceRecognition is given), else / then against the last reference keyframe (PnP-RANSAC
+// from brute-force matches, since the last pose may be stale); no new map is started, so all
+// poses stay in one world frame.
 //
 // Not thread-safe: one thread calls track(). It holds map.update_mutex() while it works on a
 // frame, so local mapping cannot rewrite poses or points under it.
 class Tracker {
  public:
-  // `map` and `sink` must outlive the tracker; `sink` may be null (no local mapping).
-  Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options = {});
+  // `map` and `sink` must outlive the tracker; `sink` may be null (no local mapping); `place`
+  // may be null (no relocalisation through the keyframe database).
+  Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options = {},
+          std::shared_ptr<PlaceRecognition> place = nullptr);
 
   TrackResult track(Frame frame);
 
@@ -74,6 +90,14 @@ class Tracker {
   // Lost frames are absent, as in track(). Call when local mapping is idle or stopped.
   Trajectory refined_trajectory() const;
 
+  // Keyframe poses were corrected behind the tracker's back (loop closing, global BA): the last
+  // tracked pose is re-expressed through its reference keyframe, as ORB-SLAM2 does, so that the
+  // motion model predicts the next frame in the corrected map. The caller holds
+  // Map::update_mutex() (so this never runs inside track()).
+  void on_map_corrected();
+  // The latest tracked pose (T_world_camera), corrected like the tracker's own state.
+  std::optional<Pose> last_tracked_world_pose() const;
+
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
 
@@ -81,6 +105,7 @@ class Tracker {
   bool initialize(Frame& frame);
   bool track_with_motion_model(Frame& frame);
   bool track_reference_keyframe(Frame& frame, bool recovering);
+  bool relocalize(Frame& frame);
   bool track_local_map(Frame& frame);
   void maybe_insert_keyframe(Frame& frame, TrackResult& result);
 
@@ -102,6 +127,7 @@ class Tracker {
   std::uint64_t last_keyframe_frame_id_ = 0;
   std::uint64_t last_recovery_frame_id_ = 0;
   LocalMap local_map_;
+  std::unique_ptr<Relocalizer> relocalizer_;  // null without a vocabulary
 
   struct FrameAnchor {
     Timestamp timestamp = 0.0;

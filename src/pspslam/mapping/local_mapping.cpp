@@ -66,6 +66,12 @@ void LocalMapping::release() {
   idle_.notify_all();
 }
 
+void LocalMapping::set_keyframe_listener(
+    std::function<void(const std::shared_ptr<KeyFrame>&)> listener) {
+  std::lock_guard lock(mutex_);
+  listener_ = std::move(listener);
+}
+
 LocalMappingStats LocalMapping::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
@@ -99,6 +105,12 @@ void LocalMapping::run(const std::stop_token& stop) {
     };
     mapper_.process(keyframe, has_new_keyframe);
 
+    std::function<void(const std::shared_ptr<KeyFrame>&)> listener;
+    {
+      std::lock_guard lock(mutex_);
+      listener = listener_;
+    }
+    if (listener && !keyframe->is_bad()) listener(keyframe);
     {
       std::lock_guard lock(mutex_);
       busy_ = false;

@@ -27,6 +27,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stop_token>
@@ -71,6 +72,10 @@ class LocalMapping {
 
   LocalMappingStats stats() const;
 
+  // Called on the worker thread with each keyframe once it is processed (and not culled): the
+  // input of loop closing. May be set at any time; empty = nobody listens.
+  void set_keyframe_listener(std::function<void(const std::shared_ptr<KeyFrame>&)> listener);
+
  private:
   void run(const std::stop_token& stop);
 
@@ -84,6 +89,7 @@ class LocalMapping {
   bool stopped_ = false;
   std::atomic<bool> abort_bundle_adjustment_{false};
   LocalMappingStats stats_;  // copy of mapper_.stats() after each keyframe, under mutex_
+  std::function<void(const std::shared_ptr<KeyFrame>&)> listener_;  // under mutex_
   // Last member: the thread starts once everything above exists, and is joined (jthread) first.
   std::jthread thread_;
 };

@@ -373,7 +373,8 @@ System::System(const SystemConfig& config, SystemOptions options)
   mapping_ = std::make_unique<MappingConnection>(std::move(mapping), place_);
   // ORB-SLAM2 wants a keyframe at least once per second of video.
   options.tracker.keyframes.max_frames_between = static_cast<int>(config.camera.fps);
-  tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker);
+  tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker,
+                                       options.place.relocalization ? place_ : nullptr);
   dynamic_options_ = options.dynamic;
   if (options.dynamic.mode != DynamicMode::off)
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);

@@ -59,7 +59,8 @@ Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
       sink_(sink),
       options_(std::move(options)),
       local_map_(options_.max_local_keyframes) {
-  if (place) relocalizer_ = std::make_unique<Relocalizer>(map_, std::move(place), options_.relocalizer);
+  if (place)
+    relocalizer_ = std::make_unique<Relocalizer>(map_, std::move(place), options_.relocalizer);
 }
 
 TrackResult Tracker::track(Frame frame) {

@@ -32,6 +32,10 @@ int synth_command(const std::vector<std::string>& args) {
   parser.add_option("bodies", "people walking around the room (0 = static twin)", "3");
   parser.add_option("seed", "random seed: same seed, same bytes", "1");
   parser.add_option("trajectory", "camera motion: handheld | loop", "handheld");
+  parser.add_option("loop-turns",
+                    "turns of the loop trajectory (1.08 revisits the start briefly; 1.5 gives "
+                    "half a turn of revisit, enough for covisibility-consistent loop detection)",
+                    "1.08");
   parser.add_option("depth-noise", "on | off: Kinect-like noise and holes (off = exact depth)",
                     "on");
   parser.add_option("carried-objects", "people carrying a box (label 100)", "1");
@@ -48,6 +52,12 @@ int synth_command(const std::vector<std::string>& args) {
   options.seed = static_cast<uint64_t>(seed);
   options.trajectory = parse_synth_trajectory(parser.get("trajectory"));
   options.depth_noise = parse_on_off(parser, "depth-noise");
+  try {
+    options.loop_turns = std::stod(parser.get("loop-turns"));
+  } catch (const std::exception&) {
+    throw Error("synth: flag --loop-turns expects a number, got '" + parser.get("loop-turns") +
+                "'");
+  }
   options.carried_objects = parser.get_int("carried-objects");
   options.threads = parser.get_int("threads");
   options.validate();

@@ -32,8 +32,12 @@ Eigen::Matrix3d rot_y(double angle) {
 
 }  // namespace
 
-CameraPath::CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room)
-    : loop_(loop), duration_s_(std::max(duration_s, 1e-3)), centre_(room.floor_centre()) {
+CameraPath::CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room,
+                       double loop_turns)
+    : loop_(loop),
+      loop_turns_(loop_turns),
+      duration_s_(std::max(duration_s, 1e-3)),
+      centre_(room.floor_centre()) {
   const uint64_t camera_seed = mix_hash(seed, 0xCA3E7Au);
   for (int i = 0; i < 16; ++i) phases_[i] = 2.0 * kPi * unit(camera_seed, static_cast<uint64_t>(i));
   yaw0_ = 2.0 * kPi * unit(camera_seed, 100);
@@ -44,8 +48,7 @@ Pose CameraPath::T_world_camera(double t) const {
   Eigen::Vector3d position;
   double yaw = 0, pitch = 0, roll = 0;
   if (loop_) {
-    constexpr double kTurns = 1.08;
-    const double angle = yaw0_ + 2.0 * kPi * kTurns * t / duration_s_;
+    const double angle = yaw0_ + 2.0 * kPi * loop_turns_ * t / duration_s_;
     // Everything but the shake is a function of the loop angle, so one turn later the camera
     // is back at the same viewpoint (within the ~3 mm / 0.4 deg shake).
     position << centre_.x() + 1.0 * std::cos(angle), centre_.y() + 0.8 * std::sin(angle),

@@ -17,17 +17,20 @@ struct RoomLayout {
 
 // Hand-held camera motion as a smooth function of time, so ground truth is exact at any t.
 // Handheld: wanders around the middle of the room looking at the walls (yaw sweeps +-80 deg).
-// Loop: walks an ellipse (~5.7 m long) looking outwards and ends 8% of a turn past its start,
-// so the last frames revisit the first viewpoint (for loop-closure tests).
+// Loop: walks an ellipse (~5.7 m long) looking outwards and ends `loop_turns` turns after its
+// start (default 1.08: 8% of a turn past it), so the last frames revisit the first viewpoint
+// (for loop-closure tests; more turns = a longer revisit, e.g. for covisibility consistency).
 class CameraPath {
  public:
-  CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room);
+  CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room,
+             double loop_turns = 1.08);
   Pose T_world_camera(double t) const;
   // Mean viewing direction (world yaw) of the hand-held camera: where people should walk.
   double mean_heading() const { return yaw0_; }
 
  private:
   bool loop_;
+  double loop_turns_;
   double duration_s_;
   Eigen::Vector2d centre_;
   double phases_[16];

@@ -177,6 +177,8 @@ void SynthOptions::validate() const {
   }
   if (threads < 0)
     throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
+  if (!(loop_turns > 0.0 && loop_turns <= 10.0))
+    throw Error("synth: flag --loop-turns must be in (0, 10], got " + std::to_string(loop_turns));
 }
 
 CameraConfig synthetic_camera_config() {
@@ -232,7 +234,8 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
     : options(opts),
       camera(synthetic_camera_config().pinhole),
       camera_path(opts.trajectory == SynthTrajectory::kLoop, opts.seed,
-                  static_cast<double>(std::max<size_t>(opts.frames, 2) - 1) / kFps, room),
+                  static_cast<double>(std::max<size_t>(opts.frames, 2) - 1) / kFps, room,
+                  opts.loop_turns),
       sensor(opts.seed) {
   options.validate();
   options.carried_objects = std::min(options.carried_objects, options.bodies);

@@ -30,6 +30,7 @@ struct SynthOptions {
   int carried_objects = 1;  // people carrying a box; clamped to `bodies`
   uint64_t seed = 1;
   SynthTrajectory trajectory = SynthTrajectory::kHandheld;
+  double loop_turns = 1.08;  // turns of the loop trajectory (> 1: the start is revisited)
   // Kinect-like sensor: noise growing with depth squared plus holes (range limits, grazing
   // angles, discontinuity shadows, dropouts). Off: depth_sensor is the exact depth.
   bool depth_noise = true;

@@ -7,11 +7,17 @@
 // tracker would provide them. No ground-truth masks exist here; frames 0-215 are a static room,
 // so dynamic flags there are false positives.
 //
-//   bench_geometry_bonn [--frames N] [--shared DIR]
+// With --poses FILE (a TUM trajectory of this clip, e.g. `pspslam run`'s trajectory.txt) the
+// camera poses come from that file instead, and each frame gets the pool of frames 5, 10, ...,
+// 5 * pool-size before it, from which the stage picks 5 by coverage (reference_selection.h), as
+// System does with its keyframes. Much faster than the PnP harness.
+//
+//   bench_geometry_bonn [--frames N] [--shared DIR] [--poses FILE] [--pool-size N]
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -24,6 +30,7 @@
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/io/trajectory_io.h"
 
 namespace {
 
@@ -61,6 +68,8 @@ double percentile(std::vector<double> v, double p) {
 }
 
 struct Frame {
+  double timestamp = 0.0;
+  std::optional<Pose> T_world_camera;  // from --poses
   cv::Mat depth;                           // undistorted, metres
   std::vector<Eigen::Vector2d> keypoints;  // undistorted pixels with a depth reading
   std::vector<float> depths;
@@ -71,12 +80,18 @@ struct Frame {
 
 int main(int argc, char** argv) {
   int max_frames = 400;
+  int pool_size = 12;
   fs::path shared = shared_dir();
+  fs::path poses_file;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--frames") max_frames = std::stoi(argv[i + 1]);
     if (key == "--shared") shared = argv[i + 1];
+    if (key == "--poses") poses_file = argv[i + 1];
+    if (key == "--pool-size") pool_size = std::stoi(argv[i + 1]);
   }
+  Trajectory poses;
+  if (!poses_file.empty()) poses = read_tum_trajectory(poses_file);
   const fs::path dir = shared / "data" / "bonn_crowd_dev";
   const SystemConfig config = load_config(source_dir() / "config" / "bonn.yaml");
   const PinholeCamera& camera = config.camera.pinhole;
@@ -101,6 +116,13 @@ int main(int argc, char** argv) {
     const cv::Mat bgr = cv::imread((dir / rgb[i].file).string());
     const cv::Mat raw = cv::imread((dir / nearest->file).string(), cv::IMREAD_ANYDEPTH);
     Frame f;
+    f.timestamp = rgb[i].t;
+    if (!poses.empty()) {
+      const auto pose = std::min_element(poses.begin(), poses.end(), [&](const auto& a, const auto& b) {
+        return std::abs(a.timestamp - rgb[i].t) < std::abs(b.timestamp - rgb[i].t);
+      });
+      if (std::abs(pose->timestamp - rgb[i].t) < 0.005) f.T_world_camera = pose->T_world_camera;
+    }
     cv::Mat metres;
     raw.convertTo(metres, CV_32F, 1.0 / config.camera.depth_factor);
     // Nearest remap: never blends depths across an object edge.
@@ -180,11 +202,21 @@ int main(int argc, char** argv) {
   exhaustive_params.search.strategy = SearchStrategy::exhaustive;
   GeometryStage ant(ideal, ant_params), exhaustive(ideal, exhaustive_params);
   std::vector<double> ant_cpu, ex_cpu, ant_wall, ex_wall, ant_search, ex_search, tested_share;
+  std::vector<double> ant_no_h, ex_no_h, selection, ant_region, ex_region;
   long static_flags = 0, static_points = 0, crowd_flags = 0, crowd_points = 0, kept = 0, found = 0;
   cv::Mat previous_mask;
   for (size_t i = 50; i < frames.size(); ++i) {
     std::vector<DepthView> references;
-    for (int r = 1; r <= 5; ++r) {
+    Pose T_world_current = Pose::Identity();
+    if (!poses.empty()) {
+      if (!frames[i].T_world_camera) continue;
+      T_world_current = *frames[i].T_world_camera;
+      for (int r = 1; r <= pool_size && static_cast<int>(i) - 5 * r >= 0; ++r) {
+        const Frame& ref = frames[i - 5 * r];
+        if (ref.T_world_camera) references.push_back({*ref.T_world_camera, ref.depth});
+      }
+    }
+    for (int r = 1; r <= 5 && poses.empty(); ++r) {
       const Frame& ref = frames[i - 10 * r];
       const std::vector<cv::DMatch> m = match(frames[i], ref);
       std::vector<cv::Point3f> object;
@@ -221,6 +253,7 @@ int main(int argc, char** argv) {
     }
     GeometryFrameInput input;
     input.depth = frames[i].depth;
+    input.T_world_camera = T_world_current;
     input.keypoints = frames[i].keypoints;
     input.keypoint_depths = frames[i].depths;
     input.references = references;
@@ -235,6 +268,11 @@ int main(int argc, char** argv) {
     ex_wall.push_back(e.timing.total_ms);
     ant_wall.push_back(a.timing.total_ms);
     ex_search.push_back(e.timing.search_cpu_ms);
+    ant_no_h.push_back(a.timing.total_cpu_ms - a.timing.homography_cpu_ms);
+    ex_no_h.push_back(e.timing.total_cpu_ms - e.timing.homography_cpu_ms);
+    selection.push_back(a.timing.selection_cpu_ms);
+    ant_region.push_back(a.timing.region_cpu_ms);
+    ex_region.push_back(e.timing.region_cpu_ms);
     ant_search.push_back(a.timing.search_cpu_ms);
     tested_share.push_back(double(a.tested_count) /
                            std::max<size_t>(1, frames[i].keypoints.size()));
@@ -250,8 +288,12 @@ int main(int argc, char** argv) {
       crowd_points += static_cast<long>(frames[i].keypoints.size());
     }
   }
-  std::printf("\ngeometry stage over %zu frames (5 PnP references each, 10 frames apart):\n",
-              ant_cpu.size());
+  if (poses.empty())
+    std::printf("\ngeometry stage over %zu frames (5 PnP references each, 10 frames apart):\n",
+                ant_cpu.size());
+  else
+    std::printf("\ngeometry stage over %zu frames (poses %s, 5 of a pool of %d frames 5 apart):\n",
+                ant_cpu.size(), poses_file.c_str(), pool_size);
   std::printf("  %-11s module cpu median %.3f ms (wall %.3f ms), search cpu median %.3f ms\n",
               "ant_colony", median(ant_cpu), median(ant_wall), median(ant_search));
   std::printf("  %-11s module cpu median %.3f ms (wall %.3f ms), search cpu median %.3f ms\n",
@@ -261,6 +303,12 @@ int main(int argc, char** argv) {
       "(median); keeps %.3f of exhaustive detections (%ld of %ld)\n",
       median(ant_cpu) / median(ex_cpu), median(ant_search) / median(ex_search),
       median(tested_share), double(kept) / std::max(1L, found), kept, found);
+  std::printf(
+      "  without the homography (System computes H in its flow step): ant %.3f ms, exhaustive "
+      "%.3f ms, ratio %.3f; reference selection %.3f ms, region growing ant %.3f / exhaustive "
+      "%.3f ms (cpu medians)\n",
+      median(ant_no_h), median(ex_no_h), median(ant_no_h) / median(ex_no_h), median(selection),
+      median(ant_region), median(ex_region));
   std::printf(
       "  dynamic share of keypoints (ant colony, final flags): static room frames <215 "
       "%.4f, crowd frames >=220 %.4f\n",

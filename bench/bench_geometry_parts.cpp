@@ -103,6 +103,28 @@ void BM_Search(benchmark::State& state) {
 }
 BENCHMARK(BM_Search)->Arg(0)->Arg(1)->ArgNames({"exhaustive"})->Unit(benchmark::kMicrosecond);
 
+// The search's own bookkeeping (grid, path, hull bands): the multi-view verdicts are computed
+// once beforehand, so the predicate is a table lookup.
+void BM_SearchBookkeeping(benchmark::State& state) {
+  const Frame& f = frame();
+  AntColonyParams params;
+  params.strategy = state.range(0) ? SearchStrategy::exhaustive : SearchStrategy::ant_colony;
+  DynamicPointSearch search(params);
+  MultiViewTest test(f.camera, MultiViewParams{});
+  test.set_frame(f.T_world_camera, f.references);
+  std::vector<std::uint8_t> verdicts;
+  for (const CandidatePoint& c : f.candidates) verdicts.push_back(test.is_dynamic(c));
+  const PointPredicate predicate = [&](int i) { return verdicts[i] != 0; };
+  const SearchResult* result = nullptr;
+  for (auto _ : state) result = &search.run(f.points, f.depth.size(), predicate);
+  state.counters["tested"] = result->tested_count;
+}
+BENCHMARK(BM_SearchBookkeeping)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgNames({"exhaustive"})
+    ->Unit(benchmark::kMicrosecond);
+
 void BM_RegionGrowing(benchmark::State& state) {
   const Frame& f = frame();
   MultiViewTest test(f.camera, MultiViewParams{});

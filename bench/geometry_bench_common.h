@@ -36,6 +36,8 @@ inline void apply_geometry_override(GeometryParams& p, const std::string& key, d
     p.search.node_spacing_px = float(value);
   else if (key == "lane_spacing_px")
     p.search.lane_spacing_px = float(value);
+  else if (key == "alternate_lanes")
+    p.search.alternate_lanes = value > 0;
   else if (key == "exhaustive")
     p.search.strategy = value > 0 ? SearchStrategy::exhaustive : SearchStrategy::ant_colony;
   else if (key == "region")
@@ -52,8 +54,16 @@ inline void apply_geometry_override(GeometryParams& p, const std::string& key, d
     p.region.static_barrier_radius_px = float(value);
   else if (key == "max_grow_radius_px")
     p.region.max_grow_radius_px = float(value);
+  else if (key == "max_grow_radius_m")
+    p.region.max_grow_radius_m = float(value);
   else if (key == "min_seeds_per_region")
     p.region.min_seeds_per_region = int(value);
+  else if (key == "wanted_coverage")
+    p.references.wanted_coverage = int(value);
+  else if (key == "older_view_gain_share")
+    p.references.older_view_gain_share = value;
+  else if (key == "point_stride")
+    p.references.point_stride = int(value);
   else if (key == "dilation_px")
     p.region.dilation_px = int(value);
   else {

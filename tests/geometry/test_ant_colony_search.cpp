@@ -20,8 +20,7 @@ struct PlantedSet {
 
 enum class Density { sparse, dense, clustered };
 
-// Background points plus planted dynamic discs (radius 30-60 px, i.e. a person's limb to torso at
-// a few metres).
+// Background points plus planted dynamic people (upright ellipses).
 PlantedSet make_set(Density density, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> x(0.0f, 639.0f), y(0.0f, 479.0f), unit(0.0f, 1.0f);
@@ -48,14 +47,16 @@ PlantedSet make_set(Density density, std::uint64_t seed) {
   set.clusters = 3;
   const int per_cluster = density == Density::sparse ? 25 : 120;
   for (int c = 0; c < set.clusters; ++c) {
-    const float radius = 30.0f + 30.0f * unit(rng);
-    const Eigen::Vector2f centre(80.0f + 480.0f * unit(rng), 70.0f + 340.0f * unit(rng));
-    // Background points falling inside a planted disc belong to it (a disc is one object).
+    // Upright ellipses 40-80 px wide and 120-220 px tall: people between ~1.5 and 4 m away.
+    const Eigen::Vector2f semi_axes(20.0f + 20.0f * unit(rng), 60.0f + 50.0f * unit(rng));
+    const Eigen::Vector2f centre(60.0f + 520.0f * unit(rng), 120.0f + 240.0f * unit(rng));
+    // Background points falling inside a planted ellipse belong to it (it is one object).
     for (size_t i = 0; i < set.points.size(); ++i)
-      if ((set.points[i] - centre).norm() < radius) set.cluster[i] = c;
+      if ((set.points[i] - centre).cwiseQuotient(semi_axes).norm() < 1.0f) set.cluster[i] = c;
     for (int k = 0; k < per_cluster; ++k) {
-      const float r = radius * std::sqrt(unit(rng)), angle = 6.2831853f * unit(rng);
-      set.points.push_back(centre + r * Eigen::Vector2f(std::cos(angle), std::sin(angle)));
+      const float r = std::sqrt(unit(rng)), angle = 6.2831853f * unit(rng);
+      set.points.push_back(centre + r * semi_axes.cwiseProduct(
+                                            Eigen::Vector2f(std::cos(angle), std::sin(angle))));
       set.cluster.push_back(c);
     }
   }
@@ -124,12 +125,16 @@ TEST(AntColonySearch, TerminatesOnAdversarialSets) {
   EXPECT_EQ(on_line.dynamic_count, 200);
 
   // A single point, and many copies of one point (hull of one vertex), both on path nodes
-  // (lanes at y = 24 + 48 k, nodes at x = 8 + 16 k).
+  // (fixed lanes at y = 24 + 48 k, nodes at x = 8 + 16 k).
+  AntColonyParams fixed_lanes;
+  fixed_lanes.lane_spacing_px = 48.0f;
+  fixed_lanes.alternate_lanes = false;
+  DynamicPointSearch on_nodes(fixed_lanes);
   const std::vector<Eigen::Vector2f> one = {{104.0f, 72.0f}};
-  EXPECT_EQ(search.run(one, kImage, always).dynamic_count, 1);
+  EXPECT_EQ(on_nodes.run(one, kImage, always).dynamic_count, 1);
   const std::vector<Eigen::Vector2f> copies(50, Eigen::Vector2f(296.0f, 120.0f));
-  EXPECT_EQ(search.run(copies, kImage, always).dynamic_count, 50);
-  EXPECT_EQ(search.run({}, kImage, always).tested_count, 0);
+  EXPECT_EQ(on_nodes.run(copies, kImage, always).dynamic_count, 50);
+  EXPECT_EQ(on_nodes.run({}, kImage, always).tested_count, 0);
 
   // A round cap is honoured even when every round finds something.
   AntColonyParams capped;
@@ -150,10 +155,32 @@ TEST(AntColonySearch, PriorityPointsSeedCommunities) {
     dynamic_ids.push_back(k);
   }
   const auto is_dynamic = [](int i) { return i < 10; };
-  DynamicPointSearch search;
+  AntColonyParams fixed_lanes;
+  fixed_lanes.lane_spacing_px = 48.0f;
+  fixed_lanes.alternate_lanes = false;
+  DynamicPointSearch search(fixed_lanes);
   EXPECT_EQ(search.run(points, kImage, is_dynamic).dynamic_count, 0);
   const std::vector<int> priority = {4};
   EXPECT_EQ(search.run(points, kImage, is_dynamic, priority).dynamic_count, 10);
+}
+
+TEST(AntColonySearch, AlternateRunsShiftTheLanesByHalfASpacing) {
+  // A short cluster exactly between two lanes of phase 0 lies on a lane of phase 1, so a mover
+  // the path passes by in one frame is found in the next one.
+  AntColonyParams params;
+  params.lane_spacing_px = 96.0f;
+  params.search_radius_px = 12.0f;
+  std::vector<Eigen::Vector2f> points;
+  for (int k = 0; k < 10; ++k) points.emplace_back(300.0f + 2.0f * k, 96.0f);  // lanes 48, 144
+  const auto always = [](int) { return true; };
+  DynamicPointSearch search(params);
+  EXPECT_EQ(search.run(points, kImage, always).dynamic_count, 0);
+  EXPECT_EQ(search.run(points, kImage, always).dynamic_count, 10);  // phase 1: lane at y = 96
+  EXPECT_EQ(search.run(points, kImage, always).dynamic_count, 0);
+  params.alternate_lanes = false;
+  DynamicPointSearch fixed(params);
+  EXPECT_EQ(fixed.run(points, kImage, always).dynamic_count, 0);
+  EXPECT_EQ(fixed.run(points, kImage, always).dynamic_count, 0);
 }
 
 TEST(ConvexHull, DegenerateAndDistance) {

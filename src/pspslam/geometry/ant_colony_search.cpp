@@ -35,6 +35,7 @@ AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
   require(p.node_spacing_px > 0.0f, section, "node_spacing_px", "must be > 0");
   p.lane_spacing_px = section.optional("lane_spacing_px", p.lane_spacing_px);
   require(p.lane_spacing_px > 0.0f, section, "lane_spacing_px", "must be > 0");
+  p.alternate_lanes = section.optional("alternate_lanes", p.alternate_lanes);
   p.max_band_rounds = section.optional("max_band_rounds", p.max_band_rounds);
   require(p.max_band_rounds >= 1, section, "max_band_rounds", "must be >= 1");
   section.finish();
@@ -44,8 +45,10 @@ AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
 DynamicPointSearch::DynamicPointSearch(AntColonyParams params) : params_(params) {}
 
 void DynamicPointSearch::build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size) {
-  // Cells of side R: a radius-R query touches at most 3x3 cells.
-  cell_size_ = std::max(params_.search_radius_px, 4.0f);
+  // Cells of side 2R: a radius-R query touches at most 2x2 cells, and a hull band of a
+  // person-sized community spans ~100 cells instead of ~400 with side R (the band scan, not the
+  // path, dominated the search's own cost).
+  cell_size_ = std::max(2.0f * params_.search_radius_px, 8.0f);
   grid_cols_ = std::max(1, static_cast<int>(std::ceil(image_size.width / cell_size_)));
   grid_rows_ = std::max(1, static_cast<int>(std::ceil(image_size.height / cell_size_)));
   const size_t cells = static_cast<size_t>(grid_cols_) * grid_rows_;
@@ -69,22 +72,25 @@ void DynamicPointSearch::build_grid(std::span<const Eigen::Vector2f> points, cv:
   }
 }
 
-void DynamicPointSearch::build_path(cv::Size image_size) {
-  if (image_size == path_size_ && !path_nodes_.empty()) return;
+void DynamicPointSearch::build_paths(cv::Size image_size) {
+  if (image_size == path_size_ && !path_nodes_[0].empty()) return;
   path_size_ = image_size;
-  path_nodes_.clear();
   // Boustrophedon path L from A (top-left) to B: lanes left-to-right then right-to-left, so
-  // consecutive nodes K_i, K_{i+1} are always one node spacing apart (paper Fig. 6).
-  const float half_lane = params_.lane_spacing_px / 2.0f;
-  bool left_to_right = true;
-  for (float y = half_lane; y < image_size.height; y += params_.lane_spacing_px) {
-    std::vector<float> xs;
-    for (float x = params_.node_spacing_px / 2.0f; x < image_size.width;
-         x += params_.node_spacing_px)
-      xs.push_back(x);
-    if (!left_to_right) std::reverse(xs.begin(), xs.end());
-    for (float x : xs) path_nodes_.emplace_back(x, y);
-    left_to_right = !left_to_right;
+  // consecutive nodes K_i, K_{i+1} are always one node spacing apart (paper Fig. 6). Phase 1 is
+  // the same path with every lane moved down by half a lane spacing.
+  const float lane = params_.lane_spacing_px;
+  for (int phase = 0; phase < 2; ++phase) {
+    std::vector<Eigen::Vector2f>& nodes = path_nodes_[phase];
+    nodes.clear();
+    bool left_to_right = true;
+    for (float y = lane / 2.0f + phase * lane / 2.0f; y < image_size.height; y += lane) {
+      const size_t lane_start = nodes.size();
+      for (float x = params_.node_spacing_px / 2.0f; x < image_size.width;
+           x += params_.node_spacing_px)
+        nodes.emplace_back(x, y);
+      if (!left_to_right) std::reverse(nodes.begin() + static_cast<long>(lane_start), nodes.end());
+      left_to_right = !left_to_right;
+    }
   }
 }
 
@@ -100,10 +106,21 @@ bool DynamicPointSearch::test(int index, const PointPredicate& is_dynamic) {
   return dynamic;
 }
 
+template <typename InBand>
+void DynamicPointSearch::test_cell(int cell, std::span<const Eigen::Vector2f> points,
+                                   const PointPredicate& is_dynamic, const InBand& in_band) {
+  for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+    const int index = cell_points_[k];
+    if (result_.tested[index] || !in_band(points[index])) continue;
+    if (test(index, is_dynamic)) found_.push_back(index);
+  }
+}
+
 void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
                                         const PointPredicate& is_dynamic) {
   ++result_.communities;
   const float band = params_.band_width_px;
+  const float half_cell = cell_size_ / 2.0f;
   for (int round = 0; round < params_.max_band_rounds; ++round) {
     ++result_.band_rounds;
     // The hull of (previous hull vertices + new finds) is the hull of every find so far, so the
@@ -119,16 +136,18 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
       for (size_t i = 0; i < hull_.size(); ++i) {
         const Eigen::Vector2f d = hull_[(i + 1) % hull_.size()] - hull_[i];
         const Eigen::Vector2f outward = Eigen::Vector2f(d.y(), -d.x()).normalized();
-        edges_.emplace_back(outward.x(), outward.y(), outward.dot(hull_[i]) + band);
+        edges_.emplace_back(outward.x(), outward.y(), outward.dot(hull_[i]) + band,
+                            half_cell * (std::abs(outward.x()) + std::abs(outward.y())));
       }
     }
     const auto in_band = [&](const Eigen::Vector2f& p) {
       if (!polygon) return distance_to_convex_hull(hull_, p) <= band;
-      for (const Eigen::Vector3f& e : edges_) {
+      for (const Eigen::Vector4f& e : edges_) {
         if (e.x() * p.x() + e.y() * p.y() > e.z()) return false;
       }
       return true;
     };
+    const auto anywhere = [](const Eigen::Vector2f&) { return true; };
     Eigen::Vector2f lo = hull_[0], hi = hull_[0];
     for (const Eigen::Vector2f& v : hull_) {
       lo = lo.cwiseMin(v);
@@ -140,21 +159,57 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
     const int col1 = std::clamp(static_cast<int>(hi.x() / cell_size_), 0, grid_cols_ - 1);
     const int row0 = std::clamp(static_cast<int>(lo.y() / cell_size_), 0, grid_rows_ - 1);
     const int row1 = std::clamp(static_cast<int>(hi.y() / cell_size_), 0, grid_rows_ - 1);
+    const float half_diagonal = half_cell * std::sqrt(2.0f);
     found_.clear();
     // The band is every untested point within dZ of the hull, interior included: points the hull
-    // swallowed in one jump would otherwise never be tested.
+    // swallowed in one jump would otherwise never be tested. Whole grid cells are classified
+    // first (outside / inside / crossing the band's edge), so only the points of crossing cells
+    // are tested against the band one by one, and exhausted cells cost one counter look-up.
     for (int row = row0; row <= row1; ++row) {
-      for (int col = col0; col <= col1; ++col) {
+      // The band is convex, so its cells in this row form one run: clip the row's x-range by
+      // every edge's half-plane (loosest over the row's height; crossing cells are exact below).
+      int first = col0, last = col1;
+      if (polygon) {
+        const float y0 = row * cell_size_, y1 = y0 + cell_size_;
+        float x_lo = lo.x(), x_hi = hi.x();
+        for (const Eigen::Vector4f& e : edges_) {
+          const float slack = e.z() - std::min(e.y() * y0, e.y() * y1);
+          if (std::abs(e.x()) < 1e-6f) {
+            if (slack < 0.0f) x_lo = x_hi + 1.0f;  // the whole row is beyond this edge
+          } else if (e.x() > 0.0f) {
+            x_hi = std::min(x_hi, slack / e.x());
+          } else {
+            x_lo = std::max(x_lo, slack / e.x());
+          }
+        }
+        if (x_lo > x_hi) continue;
+        first = std::max(col0, static_cast<int>(x_lo / cell_size_));
+        last = std::min(col1, static_cast<int>(x_hi / cell_size_));
+      }
+      for (int col = first; col <= last; ++col) {
         const int cell = row * grid_cols_ + col;
         if (cell_untested_[cell] == 0) continue;
-        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
-          const int index = cell_points_[k];
-          if (result_.tested[index]) continue;
-          const Eigen::Vector2f& p = points[index];
-          if (p.x() < lo.x() || p.y() < lo.y() || p.x() > hi.x() || p.y() > hi.y()) continue;
-          if (!in_band(p)) continue;
-          if (test(index, is_dynamic)) found_.push_back(index);
+        const Eigen::Vector2f centre((col + 0.5f) * cell_size_, (row + 0.5f) * cell_size_);
+        bool inside = true, outside = false;
+        if (polygon) {
+          for (const Eigen::Vector4f& e : edges_) {
+            const float excess = e.x() * centre.x() + e.y() * centre.y() - e.z();
+            if (excess > e.w()) {
+              outside = true;
+              break;
+            }
+            if (excess > -e.w()) inside = false;
+          }
+        } else {
+          const float d = distance_to_convex_hull(hull_, centre);
+          outside = d - half_diagonal > band;
+          inside = d + half_diagonal <= band;
         }
+        if (outside) continue;
+        if (inside)
+          test_cell(cell, points, is_dynamic, anywhere);
+        else
+          test_cell(cell, points, is_dynamic, in_band);
       }
     }
     if (found_.empty()) return;  // a band without new dynamic points ends this community
@@ -178,7 +233,8 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   }
 
   build_grid(points, image_size);
-  build_path(image_size);
+  build_paths(image_size);
+  const int phase = params_.alternate_lanes ? static_cast<int>(run_count_++ & 1u) : 0;
 
   for (int index : priority) {
     if (index < 0 || static_cast<size_t>(index) >= n || result_.tested[index]) continue;
@@ -188,24 +244,27 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   }
 
   const float radius2 = params_.search_radius_px * params_.search_radius_px;
-  for (const Eigen::Vector2f& node : path_nodes_) {
-    const int col = std::clamp(static_cast<int>(node.x() / cell_size_), 0, grid_cols_ - 1);
-    const int row = std::clamp(static_cast<int>(node.y() / cell_size_), 0, grid_rows_ - 1);
-    community_.clear();
-    for (int r = std::max(0, row - 1); r <= std::min(grid_rows_ - 1, row + 1); ++r) {
-      for (int c = std::max(0, col - 1); c <= std::min(grid_cols_ - 1, col + 1); ++c) {
+  for (const Eigen::Vector2f& node : path_nodes_[phase]) {
+    const float radius = params_.search_radius_px;
+    const int col0 = std::clamp(static_cast<int>((node.x() - radius) / cell_size_), 0, grid_cols_ - 1);
+    const int col1 = std::clamp(static_cast<int>((node.x() + radius) / cell_size_), 0, grid_cols_ - 1);
+    const int row0 = std::clamp(static_cast<int>((node.y() - radius) / cell_size_), 0, grid_rows_ - 1);
+    const int row1 = std::clamp(static_cast<int>((node.y() + radius) / cell_size_), 0, grid_rows_ - 1);
+    found_.clear();
+    const auto near_node = [&](const Eigen::Vector2f& p) {
+      return (p - node).squaredNorm() <= radius2;
+    };
+    for (int r = row0; r <= row1; ++r) {
+      for (int c = col0; c <= col1; ++c) {
         const int cell = r * grid_cols_ + c;
-        if (cell_untested_[cell] == 0) continue;
-        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
-          const int index = cell_points_[k];
-          if (result_.tested[index]) continue;
-          if ((points[index] - node).squaredNorm() > radius2) continue;
-          if (test(index, is_dynamic)) community_.push_back(points[index]);
-        }
+        if (cell_untested_[cell] != 0) test_cell(cell, points, is_dynamic, near_node);
       }
     }
     // A find leaves the path: grow this community's hull, then go on at K_{i+1}.
-    if (!community_.empty()) grow_community(points, is_dynamic);
+    if (found_.empty()) continue;
+    community_.clear();
+    for (int index : found_) community_.push_back(points[index]);
+    grow_community(points, is_dynamic);
   }
   return result_;
 }

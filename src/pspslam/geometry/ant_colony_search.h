@@ -23,7 +23,11 @@ struct AntColonyParams {
   float band_width_px = 40.0f;     // dZ: band around a community's convex hull tested per round
   float node_spacing_px = 16.0f;   // s: distance between consecutive nodes along a lane
   float lane_spacing_px = 48.0f;   // distance between the boustrophedon lanes of the path L
-  int max_band_rounds = 256;       // safety bound; a round that finds nothing ends growth anyway
+  // Shift the lanes by half a lane spacing on every other run(): a mover the path passes by in
+  // one frame lies on a lane of the next one, and once found it is followed by the priority
+  // points (previous mask) instead of the path.
+  bool alternate_lanes = true;
+  int max_band_rounds = 256;  // safety bound; a round that finds nothing ends growth anyway
 
   // Reads the optional keys of a `search:` section (strategy: ant_colony | exhaustive).
   static AntColonyParams from_yaml(YamlSection& section);
@@ -57,8 +61,12 @@ class DynamicPointSearch {
 
  private:
   void build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size);
-  void build_path(cv::Size image_size);
+  void build_paths(cv::Size image_size);
   bool test(int index, const PointPredicate& is_dynamic);
+  // Tests the untested points of one grid cell; `exact` = check each point against the band.
+  template <typename InBand>
+  void test_cell(int cell, std::span<const Eigen::Vector2f> points,
+                 const PointPredicate& is_dynamic, const InBand& in_band);
   // Grows the community whose first dynamic points are in community_ until a band adds nothing.
   void grow_community(std::span<const Eigen::Vector2f> points, const PointPredicate& is_dynamic);
 
@@ -75,11 +83,15 @@ class DynamicPointSearch {
   std::vector<int> cell_cursor_;
   std::vector<int> cell_untested_;
   cv::Size path_size_;
-  std::vector<Eigen::Vector2f> path_nodes_;
+  // Two phases of the path (lanes shifted by half a lane spacing), used on alternate runs.
+  std::vector<Eigen::Vector2f> path_nodes_[2];
+  unsigned run_count_ = 0;
   std::vector<Eigen::Vector2f> community_;
   std::vector<Eigen::Vector2f> hull_;
   std::vector<Eigen::Vector2f> hull_scratch_;
-  std::vector<Eigen::Vector3f> edges_;  // outward unit normal (x, y) and offset + dZ (z)
+  // Per hull edge: outward unit normal (x, y), offset + dZ (z), half the cell's extent along the
+  // normal (w: a cell is wholly inside the band when its centre is w inside every edge line).
+  std::vector<Eigen::Vector4f> edges_;
   std::vector<int> found_;
 };
 

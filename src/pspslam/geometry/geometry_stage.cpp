@@ -40,6 +40,22 @@ GeometryParams GeometryParams::from_yaml(YamlSection& section) {
   p.search = AntColonyParams::from_yaml(search);
   YamlSection region = section.section("region");
   p.region = RegionGrowParams::from_yaml(region);
+  YamlSection references = section.section("references");
+  p.references.wanted_coverage =
+      references.optional("wanted_coverage", p.references.wanted_coverage);
+  if (p.references.wanted_coverage < 1)
+    throw Error(references.file() + ": key '" + references.qualified("wanted_coverage") +
+                "' must be >= 1");
+  p.references.point_stride = references.optional("point_stride", p.references.point_stride);
+  if (p.references.point_stride < 1)
+    throw Error(references.file() + ": key '" + references.qualified("point_stride") +
+                "' must be >= 1");
+  p.references.older_view_gain_share =
+      references.optional("older_view_gain_share", p.references.older_view_gain_share);
+  if (!(p.references.older_view_gain_share > 0.0 && p.references.older_view_gain_share <= 1.0))
+    throw Error(references.file() + ": key '" + references.qualified("older_view_gain_share") +
+                "' must be in (0, 1]");
+  references.finish();
   p.previous_mask_prior = section.optional("previous_mask_prior", p.previous_mask_prior);
   p.output_warped_previous_mask =
       section.optional("output_warped_previous_mask", p.output_warped_previous_mask);
@@ -51,8 +67,12 @@ GeometryStage::GeometryStage(PinholeCamera camera, GeometryParams params)
     : camera_(camera),
       params_(params),
       test_(camera, params.multiview),
+      selector_(camera, {params.multiview.max_reference_views, params.references.wanted_coverage,
+                         params.references.point_stride, params.multiview.reference_patch_radius,
+                         params.multiview.max_parallax_deg,
+                         params.references.older_view_gain_share}),
       search_(params.search),
-      grower_(params.region) {}
+      grower_(params.region, static_cast<float>(camera.fx)) {}
 
 GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   const Stopwatch start;
@@ -110,9 +130,22 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
     }
   }
 
+  // Reference views: the most covering ones of a larger pool (DynaSLAM: most overlapping).
+  const Stopwatch selection_start;
+  std::span<const DepthView> references = input.references;
+  if (references.size() > static_cast<size_t>(params_.multiview.max_reference_views)) {
+    selected_references_.clear();
+    for (int v : selector_.select(input.T_world_camera, candidates_, input.references))
+      selected_references_.push_back(input.references[v]);
+    references = selected_references_;
+  }
+  result.references_used = static_cast<int>(references.size());
+  result.timing.selection_ms = selection_start.wall_ms();
+  result.timing.selection_cpu_ms = selection_start.cpu_ms();
+
   // III.C: reverse ant-colony search driving the multi-view test.
   const Stopwatch search_start;
-  test_.set_frame(input.T_world_camera, input.references);
+  test_.set_frame(input.T_world_camera, references);
   const SearchResult& search = search_.run(
       points_, input.depth.size(),
       [this](int index) { return test_.is_dynamic(candidates_[index]); }, priority_);

@@ -11,6 +11,7 @@
 #include "pspslam/geometry/ant_colony_search.h"
 #include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/geometry/multiview_test.h"
+#include "pspslam/geometry/reference_selection.h"
 #include "pspslam/geometry/region_growing.h"
 
 namespace pspslam {
@@ -24,6 +25,13 @@ struct GeometryParams {
   MultiViewParams multiview;
   AntColonyParams search;
   RegionGrowParams region;
+  // Choice of multiview.max_reference_views references when the input offers more (a keyframe
+  // pool): greedy coverage, reference_selection.h. YAML section `references:`.
+  struct ReferenceChoice {
+    int wanted_coverage = 2;  // a candidate counts as covered once this many picks see it
+    int point_stride = 8;     // coverage is estimated on every point_stride-th candidate
+    double older_view_gain_share = 1.0;  // see ReferenceSelector::Params
+  } references;
   // Test the points inside the previous frame's dynamic mask (warped into this frame by the
   // compensated homography) before walking the path.
   bool previous_mask_prior = true;
@@ -42,7 +50,9 @@ struct GeometryFrameInput {
   std::span<const Eigen::Vector2d> keypoints;  // candidate pixels (undistorted)
   // Measured depth per keypoint (metres); empty = read from `depth` at the rounded pixel.
   std::span<const float> keypoint_depths;
-  std::span<const DepthView> references;  // up to MultiViewParams::max_reference_views
+  // Reference views (keyframes); when there are more than MultiViewParams::max_reference_views,
+  // the stage picks that many by coverage of this frame's candidates (reference_selection.h).
+  std::span<const DepthView> references;
   // Matches previous -> current for the compensated homography; fewer than 4 skips it.
   std::span<const Eigen::Vector2d> matched_previous;
   std::span<const Eigen::Vector2d> matched_current;
@@ -53,10 +63,12 @@ struct GeometryFrameInput {
 // on a loaded machine wall time also counts waiting for a core.
 struct GeometryTiming {
   double homography_ms = 0.0;
+  double selection_ms = 0.0;  // choice of the reference views from a larger pool
   double search_ms = 0.0;  // ant-colony (or exhaustive) search including the multi-view tests
   double region_ms = 0.0;
   double total_ms = 0.0;
   double homography_cpu_ms = 0.0;
+  double selection_cpu_ms = 0.0;
   double search_cpu_ms = 0.0;
   double region_cpu_ms = 0.0;
   double total_cpu_ms = 0.0;
@@ -69,6 +81,7 @@ struct GeometryFrameResult {
   std::vector<std::uint8_t> keypoint_tested;
   std::vector<std::uint8_t> keypoint_tested_dynamic;
   int tested_count = 0;
+  int references_used = 0;
   int tested_dynamic_count = 0;
   int dynamic_count = 0;
   CompensatedHomography homography;  // valid = false when no matches were given
@@ -93,11 +106,13 @@ class GeometryStage {
   PinholeCamera camera_;
   GeometryParams params_;
   MultiViewTest test_;
+  ReferenceSelector selector_;
   DynamicPointSearch search_;
   DynamicRegionGrower grower_;
   std::vector<Eigen::Vector2f> points_;
   std::vector<CandidatePoint> candidates_;
   std::vector<int> priority_;
+  std::vector<DepthView> selected_references_;
   std::vector<Eigen::Vector2f> seeds_;
   std::vector<float> seed_depths_;
   std::vector<Eigen::Vector2f> static_points_;

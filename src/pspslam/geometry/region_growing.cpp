@@ -30,6 +30,8 @@ RegionGrowParams RegionGrowParams::from_yaml(YamlSection& section) {
   require(p.max_depth_from_seed_m > 0.0, section, "max_depth_from_seed_m", "must be > 0");
   p.max_grow_radius_px = section.optional("max_grow_radius_px", p.max_grow_radius_px);
   require(p.max_grow_radius_px > 0.0f, section, "max_grow_radius_px", "must be > 0");
+  p.max_grow_radius_m = section.optional("max_grow_radius_m", p.max_grow_radius_m);
+  require(p.max_grow_radius_m >= 0.0f, section, "max_grow_radius_m", "must be >= 0");
   p.min_seeds_per_region = section.optional("min_seeds_per_region", p.min_seeds_per_region);
   require(p.min_seeds_per_region >= 1, section, "min_seeds_per_region", "must be >= 1");
   p.max_region_samples = section.optional("max_region_samples", p.max_region_samples);
@@ -43,7 +45,8 @@ RegionGrowParams RegionGrowParams::from_yaml(YamlSection& section) {
   return p;
 }
 
-DynamicRegionGrower::DynamicRegionGrower(RegionGrowParams params) : params_(params) {}
+DynamicRegionGrower::DynamicRegionGrower(RegionGrowParams params, float focal_length_px)
+    : params_(params), focal_length_px_(focal_length_px) {}
 
 void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vector2f> seeds,
                                std::span<const float> seed_depths,
@@ -81,8 +84,6 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
   }
 
   constexpr int kOffsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-  const float radius_cells = params_.max_grow_radius_px / static_cast<float>(s);
-  const float radius2 = radius_cells * radius_cells;
   region_seeds_.clear();
   // Bounding box of all grown cells: the full-resolution fill only visits it.
   int min_x = cols, max_x = -1, min_y = rows, max_y = -1;
@@ -113,6 +114,10 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
       continue;
     }
     const float seed_depth = grid_depth_.at<float>(sy, sx);
+    const float radius_px = std::max(params_.max_grow_radius_px,
+                                     focal_length_px_ * params_.max_grow_radius_m / seed_depth);
+    const float radius_cells = radius_px / static_cast<float>(s);
+    const float radius2 = radius_cells * radius_cells;
     const int region_id = static_cast<int>(region_seeds_.size());
     region_seeds_.push_back(1);
     region_of_[start] = region_id;

@@ -26,6 +26,10 @@ struct RegionGrowParams {
   // Bounded growth: a seed only claims samples within this image distance of itself. A wrong
   // seed on a wall then marks a small disc, not the wall; a person is covered by many seeds.
   float max_grow_radius_px = 60.0f;
+  // The same bound in metres at the seed's depth, used where it is larger than the pixel bound
+  // (0 = off): a person 1 m away is four times larger in the image than one 4 m away, so a pixel
+  // radius either leaves near people half-masked or lets far seeds leak. Needs the focal length.
+  float max_grow_radius_m = 0.0f;
   // A grown region is kept only when at least this many dynamic seeds fall inside it, so one
   // isolated false detection does not mask anything beyond its own keypoint.
   int min_seeds_per_region = 2;
@@ -44,7 +48,8 @@ struct RegionGrowParams {
 // Reusable grower (buffers kept between frames). Not thread-safe; one per worker thread.
 class DynamicRegionGrower {
  public:
-  explicit DynamicRegionGrower(RegionGrowParams params = {});
+  // `focal_length_px` converts max_grow_radius_m into pixels (0: the metric bound is unused).
+  explicit DynamicRegionGrower(RegionGrowParams params = {}, float focal_length_px = 0.0f);
 
   // Writes `mask` (CV_8UC1, depth's size, 255 = dynamic). Seeds are pixels of dynamic points
   // with their measured depths (a seed starts at a grid sample on its own surface, never on the
@@ -58,6 +63,7 @@ class DynamicRegionGrower {
 
  private:
   RegionGrowParams params_;
+  float focal_length_px_ = 0.0f;
   cv::Mat grid_depth_;             // CV_32F, one sample per block
   std::vector<int> region_of_;     // -1 = not visited; otherwise seed region id
   std::vector<int> region_seeds_;  // dynamic seeds that fell inside each region

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -101,6 +102,36 @@ DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::pa
   }
 }
 
+// `--blackout FROM:COUNT`: frames FROM .. FROM+COUNT-1 are fed as black images without depth,
+// so tracking is really lost (relocalisation tests and demos).
+struct Blackout {
+  size_t first = 0;
+  size_t count = 0;
+  size_t end() const { return first + count; }
+  bool covers(size_t index) const { return index >= first && index < end(); }
+};
+
+Blackout parse_blackout(const std::string& value) {
+  const size_t colon = value.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    size_t used_first = 0;
+    size_t used_count = 0;
+    const std::string first = value.substr(0, colon);
+    const std::string count = value.substr(colon + 1);
+    Blackout blackout{std::stoul(first, &used_first), std::stoul(count, &used_count)};
+    if (used_first != first.size() || used_count != count.size() || first[0] == '-' ||
+        count[0] == '-' || blackout.count == 0)
+      throw std::invalid_argument("not two non-negative integers");
+    return blackout;
+  } catch (const std::logic_error&) {
+    throw Error(
+        "--blackout expects FROM:COUNT (frame index and a positive number of frames), "
+        "got '" +
+        value + "'");
+  }
+}
+
 std::ofstream open_output(const std::filesystem::path& file) {
   std::ofstream stream(file);
   if (!stream) throw Error(file.string() + ": cannot write output file");
@@ -139,10 +170,21 @@ int run_command(const std::vector<std::string>& args) {
                     "models/vocabulary/orb_k10_l5.pspvoc");
   parser.add_switch("no-relocalization",
                     "do not relocalise when tracking is lost (and do not load the vocabulary)");
+  parser.add_option("save-map",
+                    "write the final map to this file (binary, see docs/place_recognition.md)");
+  parser.add_option("load-map", "start from this saved map: the first frame is relocalised in it");
+  parser.add_switch("localization",
+                    "localisation only (needs --load-map): track in the map, never add to it");
+  parser.add_option("blackout",
+                    "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
+                    "(tracking is lost for real; tests relocalisation)");
   parser.add_option("cull-hits",
                     "erase a map point after it lay on dynamic pixels in this many frames", "3");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
+  const std::optional<Blackout> blackout =
+      parser.has("blackout") ? std::optional<Blackout>(parse_blackout(parser.get("blackout")))
+                             : std::nullopt;
   if (max_frames_flag < 0)
     throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
 
@@ -185,6 +227,15 @@ int run_command(const std::vector<std::string>& args) {
             << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
             << "\n";
   system_options.place.relocalization = !parser.flag("no-relocalization");
+  if (parser.flag("localization") && !parser.has("load-map"))
+    throw Error("--localization needs --load-map FILE (a map to localise in)");
+  if (parser.has("load-map")) {
+    system_options.map_file = parser.get("load-map");
+    system_options.localization_only = parser.flag("localization");
+    std::cout << "map:          " << system_options.map_file.string()
+              << (system_options.localization_only ? " (localisation only)" : " (extended)")
+              << "\n";
+  }
   system_options.place.vocabulary = parser.get("vocabulary");
   if (system_options.place.vocabulary.is_relative())
     system_options.place.vocabulary = source_dir() / system_options.place.vocabulary;
@@ -213,6 +264,18 @@ int run_command(const std::vector<std::string>& args) {
   // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
   // network segments frame i+1 while frame i is tracked.
   std::optional<RgbdFrame> next;
+  const auto load_frame = [&](size_t index) {
+    RgbdFrame loaded = sequence.load(index);
+    if (blackout && blackout->covers(index)) {
+      loaded.bgr.setTo(cv::Scalar::all(0));
+      if (!loaded.gray.empty()) loaded.gray.setTo(cv::Scalar::all(0));
+      loaded.depth.setTo(cv::Scalar::all(0));
+    }
+    return loaded;
+  };
+  size_t relocalisations = 0;
+  std::optional<size_t> first_pose_after_blackout;
+  std::string first_method_after_blackout;
   for (size_t i = 0; i < frames; ++i) {
     if (interrupted()) break;
     if (dynamic.realtime) {
@@ -228,10 +291,10 @@ int run_command(const std::vector<std::string>& args) {
       if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
       next.reset();
     }
-    const RgbdFrame frame = next ? std::move(*next) : sequence.load(i);
+    const RgbdFrame frame = next ? std::move(*next) : load_frame(i);
     next.reset();
     if (!dynamic.realtime && i + 1 < frames) {
-      next = sequence.load(i + 1);
+      next = load_frame(i + 1);
       if (i == 0) system.announce(frame);
       system.announce(*next);
     }
@@ -243,6 +306,11 @@ int run_command(const std::vector<std::string>& args) {
     }
     const FrameReport report = system.process(frame);
     const TrackResult& result = report.tracking;
+    if (result.method == TrackingMethod::kRelocalisation) ++relocalisations;
+    if (blackout && i >= blackout->end() && !first_pose_after_blackout && result.T_world_camera) {
+      first_pose_after_blackout = i;
+      first_method_after_blackout = to_string(result.method);
+    }
     if (result.T_world_camera) {
       trajectory.write(frame.timestamp, *result.T_world_camera);
       estimate.push_back({frame.timestamp, *result.T_world_camera});
@@ -300,6 +368,13 @@ int run_command(const std::vector<std::string>& args) {
   }
   progress.finish();
   system.shutdown();
+  if (parser.has("save-map")) {
+    const std::filesystem::path map_file = parser.get("save-map");
+    const auto [saved_keyframes, saved_points] = system.save_map(map_file);
+    std::cout << "map saved:    " << map_file.string() << " (" << saved_keyframes << " keyframes, "
+              << saved_points << " map points, " << std::filesystem::file_size(map_file) / 1024
+              << " KiB)\n";
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_tum_trajectory(out_dir / "keyframes.txt", system.keyframe_trajectory());
@@ -350,6 +425,47 @@ int run_command(const std::vector<std::string>& args) {
     }
   }
 
+  // Blackout: how soon a pose came back, and how good the poses after the return are (errors
+  // of the whole run's alignment, restricted to frames from the return on).
+  std::optional<ErrorStats> after_return;
+  std::string blackout_json;  // a stats.json member, empty without --blackout
+  if (blackout) {
+    std::snprintf(line, sizeof(line), "blackout:     frames %zu-%zu black, %zu relocalisations; ",
+                  blackout->first, blackout->end() - 1, relocalisations);
+    std::cout << line;
+    if (first_pose_after_blackout) {
+      std::snprintf(line, sizeof(line), "first pose after the return at frame %zu (+%zu) by %s\n",
+                    *first_pose_after_blackout, *first_pose_after_blackout - blackout->end(),
+                    first_method_after_blackout.c_str());
+      std::cout << line;
+    } else {
+      std::cout << "no pose after the return\n";
+    }
+    if (ate_tracked && blackout->end() < frames) {
+      const Timestamp returned = sequence.timestamp(blackout->end());
+      std::vector<double> errors;
+      for (const AtePair& pair : ate_tracked->pairs) {
+        if (pair.est_timestamp >= returned) errors.push_back(pair.error);
+      }
+      if (!errors.empty()) {
+        after_return = compute_error_stats(errors);
+        std::snprintf(line, sizeof(line),
+                      "              after the return: %zu poses, error RMSE %.4f m, max %.4f m\n",
+                      after_return->count, after_return->rmse, after_return->max);
+        std::cout << line;
+      }
+    }
+    std::snprintf(
+        line, sizeof(line),
+        "  \"blackout\": {\"first\": %zu, \"count\": %zu, \"frames_to_first_pose\": "
+        "%ld, \"after_return_rmse_m\": %.5f, \"after_return_max_m\": %.5f},\n",
+        blackout->first, blackout->count,
+        first_pose_after_blackout ? static_cast<long>(*first_pose_after_blackout - blackout->end())
+                                  : -1L,
+        after_return ? after_return->rmse : -1.0, after_return ? after_return->max : -1.0);
+    blackout_json = line;
+  }
+
   // Per-module timing and the dynamic-feature totals, printed and written to stats.json.
   const TimingSummary t_extraction = summarize(extraction_ms);
   const TimingSummary t_semantic = summarize(semantic_ms);
@@ -390,7 +506,8 @@ int run_command(const std::vector<std::string>& args) {
          << "  \"interrupted\": " << (interrupted() ? "true" : "false") << ",\n"
          << "  \"frames\": " << processed << ",\n"
          << "  \"lost_frames\": " << lost_count << ",\n"
-         << "  \"realtime_dropped_frames\": " << realtime_dropped << ",\n"
+         << "  \"relocalisations\": " << relocalisations << ",\n"
+         << blackout_json << "  \"realtime_dropped_frames\": " << realtime_dropped << ",\n"
          << "  \"seconds\": " << seconds << ",\n"
          << "  \"fps\": " << fps << ",\n"
          << "  \"timing_ms\": {\n"

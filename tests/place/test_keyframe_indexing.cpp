@@ -67,10 +67,6 @@ TEST(KeyFrameIndexing, MissingVocabularyIsAClearErrorNamingTheFile) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/vocabulary.pspvoc"), std::string::npos)
         << e.what();
   }
-  // Without relocalisation nothing needs the vocabulary: it is not even opened.
-  options.place.relocalization = false;
-  System system(synthetic_system_config(), options);
-  EXPECT_EQ(system.place_recognition(), nullptr);
 }
 
 }  // namespace

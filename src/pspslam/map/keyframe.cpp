@@ -1,7 +1,10 @@
 #include "pspslam/map/keyframe.h"
 
 #include <algorithm>
+#include <limits>
+#include <string>
 
+#include "pspslam/core/error.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/map_point.h"
 #include "pspslam/place/vocabulary.h"
@@ -11,6 +14,24 @@ namespace {
 
 // ORB-SLAM2's covisibility edge threshold: keyframes sharing fewer points are not neighbours.
 constexpr int kMinCovisibilityWeight = 15;
+
+// Virtual right coordinate of each keypoint (as Frame computes it), NaN without depth.
+std::vector<float> right_coordinates(std::uint64_t frame_id,
+                                     const std::vector<cv::KeyPoint>& keypoints,
+                                     const cv::Mat& descriptors, const std::vector<float>& depth,
+                                     const RgbdCamera& camera) {
+  if (depth.size() != keypoints.size() || descriptors.rows != static_cast<int>(keypoints.size())) {
+    throw Error("keyframe of frame " + std::to_string(frame_id) + ": " +
+                std::to_string(keypoints.size()) + " keypoints but " +
+                std::to_string(depth.size()) + " depths and " + std::to_string(descriptors.rows) +
+                " descriptors");
+  }
+  std::vector<float> right_u(keypoints.size(), std::numeric_limits<float>::quiet_NaN());
+  for (size_t i = 0; i < right_u.size(); ++i) {
+    if (depth[i] > 0.0f) right_u[i] = keypoints[i].pt.x - static_cast<float>(camera.bf / depth[i]);
+  }
+  return right_u;
+}
 
 }  // namespace
 
@@ -38,6 +59,23 @@ void KeyFrame::compute_bow(const Vocabulary& vocabulary, int direct_index_level)
   if (bow_ready_.load(std::memory_order_relaxed)) return;
   vocabulary.transform(descriptors_, bow_, features_, direct_index_level);
   bow_ready_.store(true, std::memory_order_release);
+}
+
+KeyFrame::KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const RgbdCamera> camera,
+                   std::shared_ptr<const ScalePyramid> pyramid)
+    : id_(id),
+      frame_id_(data.frame_id),
+      timestamp_(data.timestamp),
+      keypoints_(std::move(data.keypoints)),
+      descriptors_(std::move(data.descriptors)),
+      depth_(std::move(data.depth)),
+      right_u_(right_coordinates(data.frame_id, keypoints_, descriptors_, depth_, *camera)),
+      camera_(std::move(camera)),
+      pyramid_(std::move(pyramid)),
+      grid_(keypoints_, camera_->min_x, camera_->max_x, camera_->min_y, camera_->max_y),
+      T_camera_world_(data.T_camera_world),
+      T_world_camera_(data.T_camera_world.inverse()) {
+  map_points_.resize(keypoints_.size());
 }
 
 Pose KeyFrame::T_camera_world() const {

@@ -21,6 +21,17 @@ class Frame;
 class MapPoint;
 class Vocabulary;
 
+// Everything a keyframe is built from besides its id, camera and pyramid: what a map file
+// stores (the map point associations and graph links are restored separately).
+struct KeyFrameData {
+  std::uint64_t frame_id = 0;
+  Timestamp timestamp = 0.0;
+  Pose T_camera_world = Pose::Identity();
+  std::vector<cv::KeyPoint> keypoints;  // undistorted
+  cv::Mat descriptors;                  // N x 32 CV_8U
+  std::vector<float> depth;             // per keypoint, <= 0: none
+};
+
 // A frame kept in the map. Owned by Map; everything it refers to (its map points, covisible
 // keyframes, spanning-tree parent and children) is held by weak_ptr, so the Map stays the only
 // owner. Pose, associations and connections are guarded separately because tracking reads
@@ -30,6 +41,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   // Copies the frame's features and pose (the frame must have a pose) and its map point
   // associations (non-outlier ones); it does not register itself as an observation.
   KeyFrame(std::uint64_t id, const Frame& frame);
+  // Rebuilds a keyframe (map loading): right_u and the feature grid are derived again.
+  // Throws pspslam::Error when the per-keypoint arrays disagree in length.
+  KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const RgbdCamera> camera,
+           std::shared_ptr<const ScalePyramid> pyramid);
 
   std::uint64_t id() const { return id_; }
   std::uint64_t frame_id() const { return frame_id_; }

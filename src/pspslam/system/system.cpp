@@ -60,6 +60,7 @@
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/mapping/local_mapping.h"
+#include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/onnx_segmenter.h"
 #include "pspslam/semantic/semantic_thread.h"
@@ -359,6 +360,11 @@ System::System(const SystemConfig& config, SystemOptions options)
       pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
       extractor_(std::make_unique<OrbExtractor>(config.orb)),
       map_(std::make_shared<Map>()) {
+  if (options.localization_only) {
+    // Nothing may change the map: no keyframes means nothing for these threads to do.
+    options.local_mapping = false;
+    options.tracker.localization_only = true;
+  }
   if (options.place.needs_vocabulary()) {
     const std::filesystem::path vocabulary =
         options.place.vocabulary.empty() ? default_vocabulary_path() : options.place.vocabulary;
@@ -375,6 +381,16 @@ System::System(const SystemConfig& config, SystemOptions options)
   options.tracker.keyframes.max_frames_between = static_cast<int>(config.camera.fps);
   tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker,
                                        options.place.relocalization ? place_ : nullptr);
+  if (!options.map_file.empty()) {
+    load_map(options.map_file, *map_, camera_, pyramid_);
+    if (place_) {
+      for (const auto& keyframe : map_->keyframes()) {
+        keyframe->compute_bow(place_->vocabulary(), place_->direct_index_level());
+        place_->database().add(keyframe->id(), keyframe->bow_vector());
+      }
+    }
+    tracker_->start_in_loaded_map();
+  }
   dynamic_options_ = options.dynamic;
   if (options.dynamic.mode != DynamicMode::off)
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
@@ -441,6 +457,11 @@ FrameReport System::process(const RgbdFrame& frame) {
 }
 
 void System::shutdown() { mapping_->stop(); }
+
+std::pair<size_t, size_t> System::save_map(const std::filesystem::path& file) {
+  const MapFileSummary summary = pspslam::save_map(*map_, *camera_, *pyramid_, file);
+  return {summary.keyframes, summary.map_points};
+}
 
 Trajectory System::keyframe_trajectory() const {
   Trajectory trajectory;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <utility>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
@@ -61,6 +62,12 @@ struct SystemOptions {
   bool local_mapping = true;
   DynamicOptions dynamic;
   PlaceOptions place;
+  // Map file to start from (`pspslam run --load-map`, persistence/map_file.h); empty: start a
+  // new map. The first frame is relocalised in it (needs place.relocalization).
+  std::filesystem::path map_file;
+  // Localisation only (`--localization`): track against the map, never insert keyframes; no
+  // local mapping and no loop closing run.
+  bool localization_only = false;
 };
 
 // What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
@@ -132,6 +139,10 @@ class System {
 
   // Lets local mapping finish its queue, then stops its thread. Idempotent.
   void shutdown();
+
+  // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
+  // Returns the number of keyframes and map points written.
+  std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
 
   // Keyframe poses (T_world_camera), by keyframe id.
   Trajectory keyframe_trajectory() const;

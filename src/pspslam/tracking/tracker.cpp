@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include "pspslam/core/error.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
@@ -331,7 +332,15 @@ bool Tracker::track_local_map(Frame& frame) {
   return inliers >= needed;
 }
 
+void Tracker::start_in_loaded_map() {
+  if (!relocalizer_)
+    throw Error("tracking in a loaded map needs relocalisation (a vocabulary); it is disabled");
+  if (map_.num_keyframes() == 0) throw Error("tracking in a loaded map: the map is empty");
+  state_ = TrackingState::kLost;
+}
+
 void Tracker::maybe_insert_keyframe(Frame& frame, TrackResult& result) {
+  if (options_.localization_only) return;
   KeyFrameEvidence evidence;
   evidence.frame_id = frame.id();
   evidence.last_keyframe_frame_id = last_keyframe_frame_id_;

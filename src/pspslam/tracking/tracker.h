@@ -31,6 +31,9 @@ struct TrackerOptions {
   int min_local_map_inliers_after_recovery = 50;
   size_t max_local_keyframes = 80;
   KeyFramePolicyOptions keyframes;
+  // Localisation only: track against the existing map, never insert keyframes (so no points
+  // or local mapping either). With a loaded map, see Tracker::start_in_loaded_map().
+  bool localization_only = false;
   MatcherOptions matcher;
   PoseOptimizerOptions pose_optimizer;
   RelocalizerOptions relocalizer;
@@ -97,6 +100,11 @@ class Tracker {
   void on_map_corrected();
   // The latest tracked pose (T_world_camera), corrected like the tracker's own state.
   std::optional<Pose> last_tracked_world_pose() const;
+
+  // The map was loaded from a file: the first frame is relocalised in it instead of starting a
+  // new map. Call before the first track(). Throws pspslam::Error without a PlaceRecognition
+  // (nothing else can find the camera in an existing map) or with an empty map.
+  void start_in_loaded_map();
 
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }

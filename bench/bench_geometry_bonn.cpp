@@ -8,9 +8,9 @@
 // so dynamic flags there are false positives.
 //
 // With --poses FILE (a TUM trajectory of this clip, e.g. `pspslam run`'s trajectory.txt) the
-// camera poses come from that file instead, and each frame gets the pool of frames 5, 10, ...,
-// 5 * pool-size before it, from which the stage picks 5 by coverage (reference_selection.h), as
-// System does with its keyframes. Much faster than the PnP harness.
+// camera poses come from that file instead, and each frame gets a pool of `pool-size` earlier
+// frames at multiples of 5 (keyframe-like: consecutive frames share them), from which the stage
+// picks 5 by coverage (reference_selection.h). Much faster than the PnP harness.
 //
 //   bench_geometry_bonn [--frames N] [--shared DIR] [--poses FILE] [--pool-size N]
 #include <algorithm>
@@ -211,8 +211,11 @@ int main(int argc, char** argv) {
     if (!poses.empty()) {
       if (!frames[i].T_world_camera) continue;
       T_world_current = *frames[i].T_world_camera;
-      for (int r = 1; r <= pool_size && static_cast<int>(i) - 5 * r >= 0; ++r) {
-        const Frame& ref = frames[i - 5 * r];
+      // Keyframe-like pool: frames at multiples of 5 before this one (newest first), so
+      // consecutive frames share their pool as they would share keyframes.
+      const int newest = (static_cast<int>(i) - 1) / 5 * 5;
+      for (int r = 0; r < pool_size && newest - 5 * r >= 0; ++r) {
+        const Frame& ref = frames[newest - 5 * r];
         if (ref.T_world_camera) references.push_back({*ref.T_world_camera, ref.depth});
       }
     }

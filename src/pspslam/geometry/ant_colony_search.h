@@ -20,9 +20,11 @@ enum class SearchStrategy {
 struct AntColonyParams {
   SearchStrategy strategy = SearchStrategy::ant_colony;
   float search_radius_px = 12.0f;  // R: points within R of a path node K_i are tested
-  float band_width_px = 40.0f;     // dZ: band around a community's convex hull tested per round
+  float band_width_px = 80.0f;     // dZ: band around a community's convex hull tested per round
   float node_spacing_px = 16.0f;   // s: distance between consecutive nodes along a lane
-  float lane_spacing_px = 48.0f;   // distance between the boustrophedon lanes of the path L
+  // Distance between the horizontal boustrophedon lanes of the path L. Lanes run across the
+  // image, so a standing person (120+ px tall up to ~4 m away) always crosses one of them.
+  float lane_spacing_px = 96.0f;
   // Shift the lanes by half a lane spacing on every other run(): a mover the path passes by in
   // one frame lies on a lane of the next one, and once found it is followed by the priority
   // points (previous mask) instead of the path.

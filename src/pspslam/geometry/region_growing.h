@@ -19,17 +19,17 @@ struct RegionGrowParams {
   // Neighbouring samples belong to the same surface when their depths differ by at most
   // abs + relative * depth (depth continuity).
   double max_step_abs_m = 0.03;
-  double max_step_relative = 0.02;
+  double max_step_relative = 0.01;
   // A region stays within this distance in depth of the seed that started it: stops the classic
   // leak from a person's feet along the floor.
-  double max_depth_from_seed_m = 0.6;
+  double max_depth_from_seed_m = 0.3;
   // Bounded growth: a seed only claims samples within this image distance of itself. A wrong
   // seed on a wall then marks a small disc, not the wall; a person is covered by many seeds.
   float max_grow_radius_px = 60.0f;
   // The same bound in metres at the seed's depth, used where it is larger than the pixel bound
   // (0 = off): a person 1 m away is four times larger in the image than one 4 m away, so a pixel
   // radius either leaves near people half-masked or lets far seeds leak. Needs the focal length.
-  float max_grow_radius_m = 0.0f;
+  float max_grow_radius_m = 0.5f;
   // A grown region is kept only when at least this many dynamic seeds fall inside it, so one
   // isolated false detection does not mask anything beyond its own keypoint.
   int min_seeds_per_region = 2;

@@ -102,6 +102,21 @@ DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::pa
   }
 }
 
+// `--loop-closing on|off|auto`: auto = on when the vocabulary file exists.
+bool parse_loop_closing(const std::string& value, const std::filesystem::path& vocabulary) {
+  if (value != "on" && value != "off" && value != "auto")
+    throw Error("--loop-closing expects on, off or auto, got '" + value + "'");
+  return value == "on" || (value == "auto" && std::filesystem::exists(vocabulary));
+}
+
+void print_loop_stats(const MappingStats& mapping) {
+  std::printf(
+      "loops:        %zu closed (last moved its keyframe %.3f m), %zu candidates rejected by "
+      "geometry; global BA %zu applied, %zu aborted (last %.2f s)\n",
+      mapping.loops_closed, mapping.last_loop_correction_m, mapping.loop_candidates_rejected,
+      mapping.global_ba_applied, mapping.global_ba_aborted, mapping.last_global_ba_seconds);
+}
+
 // `--blackout FROM:COUNT`: frames FROM .. FROM+COUNT-1 are fed as black images without depth,
 // so tracking is really lost (relocalisation tests and demos).
 struct Blackout {
@@ -178,13 +193,18 @@ int run_command(const std::vector<std::string>& args) {
   parser.add_option("blackout",
                     "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
                     "(tracking is lost for real; tests relocalisation)");
+  parser.add_option("loop-closing",
+                    "on | off | auto: loop closing thread (detection, essential-graph correction, "
+                    "global BA); auto = on when the vocabulary file exists",
+                    "auto");
   parser.add_option("cull-hits",
                     "erase a map point after it lay on dynamic pixels in this many frames", "3");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
-  const std::optional<Blackout> blackout =
-      parser.has("blackout") ? std::optional<Blackout>(parse_blackout(parser.get("blackout")))
-                             : std::nullopt;
+  // Assigned, not built by a conditional expression: GCC 12 then reports a false
+  // "maybe-uninitialized" on blackout->end() under -Werror.
+  std::optional<Blackout> blackout;
+  if (parser.has("blackout")) blackout = parse_blackout(parser.get("blackout"));
   if (max_frames_flag < 0)
     throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
 
@@ -239,6 +259,9 @@ int run_command(const std::vector<std::string>& args) {
   system_options.place.vocabulary = parser.get("vocabulary");
   if (system_options.place.vocabulary.is_relative())
     system_options.place.vocabulary = source_dir() / system_options.place.vocabulary;
+  system_options.place.loop_closing =
+      parse_loop_closing(parser.get("loop-closing"), system_options.place.vocabulary);
+  std::cout << "loop closing: " << (system_options.place.loop_closing ? "on" : "off") << "\n";
   System system(setup.config, system_options);
   InterruptGuard interrupt_guard;
   ProgressBar progress("slam", frames, std::cerr);
@@ -400,6 +423,7 @@ int run_command(const std::vector<std::string>& args) {
                 mapping.processed_keyframes, mapping.keyframes_culled, mapping.points_triangulated,
                 mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed);
   std::cout << line;
+  if (system_options.place.loop_closing) print_loop_stats(mapping);
   std::cout << "output:       " << (out_dir / "trajectory.txt").string() << " ("
             << trajectory.count()
             << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
@@ -527,7 +551,10 @@ int run_command(const std::vector<std::string>& args) {
          << "  \"mask_latency\": {\"frames\": " << json_timing(mask_age)
          << ", \"ms\": " << json_timing(mask_latency) << "},\n"
          << "  \"map\": {\"keyframes\": " << mapping.keyframes_in_map
-         << ", \"map_points\": " << mapping.map_points << "}";
+         << ", \"map_points\": " << mapping.map_points << "},\n"
+         << "  \"loops\": {\"enabled\": " << (system_options.place.loop_closing ? "true" : "false")
+         << ", \"closed\": " << mapping.loops_closed
+         << ", \"global_ba_applied\": " << mapping.global_ba_applied << "}";
     const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
         {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
     for (const auto& [key, ate] : ates) {

@@ -59,6 +59,7 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
+#include "pspslam/loop/loop_closing.h"
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
@@ -108,6 +109,11 @@ class System::MappingConnection final : public KeyFrameSink {
   void interrupt_bundle_adjustment() override {
     if (mapping_) mapping_->interrupt_bundle_adjustment();
   }
+
+  void wait_until_idle() {
+    if (mapping_) mapping_->wait_until_idle();
+  }
+  LocalMapping* local_mapping() const { return mapping_.get(); }
 
   // Drains the queue (so the final map includes every keyframe), then joins the thread.
   void stop() {
@@ -252,6 +258,10 @@ class System::DynamicPipeline {
     for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
   }
 
+  // The map was corrected under the last tracked pose (loop closing): take the corrected one.
+  void reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
+    if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
+  }
   // Step 6 and the state for the next frame.
   void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
                  DynamicReport& report) {
@@ -363,6 +373,7 @@ System::System(const SystemConfig& config, SystemOptions options)
   if (options.localization_only) {
     // Nothing may change the map: no keyframes means nothing for these threads to do.
     options.local_mapping = false;
+    options.place.loop_closing = false;
     options.tracker.localization_only = true;
   }
   if (options.place.needs_vocabulary()) {
@@ -390,6 +401,19 @@ System::System(const SystemConfig& config, SystemOptions options)
       }
     }
     tracker_->start_in_loaded_map();
+  }
+  if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
+    // The callback runs on a loop closing thread with Map::update_mutex() held, so the tracker
+    // (which holds it for a whole frame) is never re-anchored in the middle of a frame.
+    loop_closing_ = std::make_unique<LoopClosing>(map_, place_, mapping_->local_mapping(),
+                                                  LoopClosingOptions{}, [this] {
+                                                    tracker_->on_map_corrected();
+                                                    ++map_corrections_;
+                                                  });
+    mapping_->local_mapping()->set_keyframe_listener(
+        [loop = loop_closing_.get()](const std::shared_ptr<KeyFrame>& keyframe) {
+          loop->insert_keyframe(keyframe);
+        });
   }
   dynamic_options_ = options.dynamic;
   if (options.dynamic.mode != DynamicMode::off)
@@ -440,6 +464,15 @@ FrameReport System::process(const RgbdFrame& frame) {
   OrbFeatures features;
   extractor_->extract(gray, semantic_mask, features);
   report.extraction_ms = milliseconds_since(extraction_start);
+  {
+    // A loop correction or global BA moved the map since the last frame: the geometry prior
+    // must start from the tracker's corrected pose, not the one recorded before the move.
+    std::lock_guard lock(map_->update_mutex());
+    if (map_corrections_ != map_corrections_seen_) {
+      map_corrections_seen_ = map_corrections_;
+      dynamic_->reanchor_last_pose(tracker_->last_tracked_world_pose());
+    }
+  }
   dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),
@@ -456,7 +489,18 @@ FrameReport System::process(const RgbdFrame& frame) {
   return report;
 }
 
-void System::shutdown() { mapping_->stop(); }
+void System::shutdown() {
+  if (loop_closing_ && mapping_->local_mapping() != nullptr) {
+    // Every keyframe reaches loop closing, its loops are closed and the global BA is applied
+    // (offline runs want the final map); a correction may have paused local mapping meanwhile.
+    mapping_->wait_until_idle();
+    loop_closing_->wait_until_idle();
+    mapping_->wait_until_idle();
+    mapping_->local_mapping()->set_keyframe_listener({});
+    // loop_closing_ stays (idle, its threads parked) so that mapping_stats() can report it.
+  }
+  mapping_->stop();
+}
 
 std::pair<size_t, size_t> System::save_map(const std::filesystem::path& file) {
   const MapFileSummary summary = pspslam::save_map(*map_, *camera_, *pyramid_, file);
@@ -476,6 +520,15 @@ MappingStats System::mapping_stats() const {
   stats.keyframes_in_map = map_->num_keyframes();
   stats.map_points = map_->num_map_points();
   mapping_->fill(stats);
+  if (loop_closing_) {
+    const LoopClosingStats loop = loop_closing_->stats();
+    stats.loops_closed = loop.loops_closed;
+    stats.loop_candidates_rejected = loop.detector.rejected_geometry;
+    stats.global_ba_applied = loop.global_ba_applied;
+    stats.global_ba_aborted = loop.global_ba_aborted;
+    stats.last_loop_correction_m = loop.last_correction.correction_m;
+    stats.last_global_ba_seconds = loop.last_global_ba_seconds;
+  }
   return stats;
 }
 

@@ -18,6 +18,7 @@
 namespace pspslam {
 
 class LocalMapping;
+class LoopClosing;
 class Map;
 class OrbExtractor;
 class PlaceRecognition;
@@ -50,8 +51,12 @@ struct PlaceOptions {
   // then loaded (~0.1 s) and every keyframe gets a BoW vector in local mapping.
   bool relocalization = true;
 
-  // True when anything needs the vocabulary (relocalisation; loop closing joins here).
-  bool needs_vocabulary() const { return relocalization; }
+  // Loop closing thread (`pspslam run --loop-closing`): detection, correction, global BA.
+  // Needs the vocabulary and local mapping.
+  bool loop_closing = true;
+
+  // True when anything needs the vocabulary (relocalisation, loop closing).
+  bool needs_vocabulary() const { return relocalization || loop_closing; }
 };
 
 struct SystemOptions {
@@ -111,6 +116,13 @@ struct MappingStats {
   size_t points_triangulated = 0;
   size_t points_fused = 0;
   size_t ba_outliers_removed = 0;
+  // Loop closing (all zero when it is off).
+  size_t loops_closed = 0;
+  size_t loop_candidates_rejected = 0;  // consistent BoW candidates failing verification
+  size_t global_ba_applied = 0;
+  size_t global_ba_aborted = 0;
+  double last_loop_correction_m = 0.0;  // how far the last loop moved its keyframe
+  double last_global_ba_seconds = 0.0;
 };
 
 // The SLAM system: owns the map, the ORB extractor, the tracker (runs on the caller's thread
@@ -137,7 +149,8 @@ class System {
   // in the order they are processed; a frame not announced is submitted by process().
   void announce(const RgbdFrame& frame);
 
-  // Lets local mapping finish its queue, then stops its thread. Idempotent.
+  // Lets local mapping finish its queue and loop closing its loops and global bundle
+  // adjustment, then stops their threads. Idempotent.
   void shutdown();
 
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
@@ -169,6 +182,13 @@ class System {
   // Declared before tracker_ so it is destroyed after it (the tracker points to it).
   std::unique_ptr<MappingConnection> mapping_;
   std::unique_ptr<Tracker> tracker_;
+  // After mapping_ and tracker_: it stops local mapping and re-anchors the tracker, so it is
+  // destroyed (threads joined) before them. Null when loop closing is off.
+  std::unique_ptr<LoopClosing> loop_closing_;
+  // Loop corrections / global BAs applied so far (written under Map::update_mutex()); the
+  // dynamic pipeline re-reads the tracker's pose when it changed.
+  std::uint64_t map_corrections_ = 0;
+  std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
   DynamicOptions dynamic_options_;
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.

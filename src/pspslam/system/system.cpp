@@ -29,6 +29,14 @@
 //   local mapping thread    LocalMapping (mapping/): queue of keyframes; per keyframe point
 //                             culling, triangulation, fusion, local BA, keyframe culling; it
 //                             takes Map::update_mutex() while it writes BA results back
+//                                  | LocalMapping::set_keyframe_listener (processed keyframes)
+//                                  v
+//   loop closing thread     LoopClosing (loop/): BoW detection with covisibility consistency,
+//                             3D-3D RANSAC verification; for a loop: stops local mapping,
+//                             correct_loop() under Map::update_mutex() (fusion, essential
+//                             graph), re-anchors the tracker, releases local mapping
+//   global BA thread        started after each loop: solves on a snapshot, writes back under
+//                             Map::update_mutex() with local mapping stopped (docs/loop_closing.md)
 //
 // Why geometry runs on the caller thread, after extraction and before tracking: it needs the
 // frame's keypoints (extraction) and a pose (the motion-model prior is good to a few cm at 30 Hz,

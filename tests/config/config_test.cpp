@@ -59,6 +59,8 @@ TEST(Config, SaveLoadRoundTrip) {
   config.camera.fps = 15.0;
   config.camera.depth_factor = 1000.0;
   config.camera.depth_threshold = 3.5;
+  config.camera.depth_noise = CameraConfig::DepthNoise::kinect_v1;
+  config.camera.depth_noise_scale = 1.5;
   config.orb.n_features = 1500;
   config.orb.scale_factor = 1.3;
   config.orb.n_levels = 6;
@@ -77,6 +79,8 @@ TEST(Config, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded.camera.fps, 15.0);
   EXPECT_EQ(loaded.camera.depth_factor, 1000.0);
   EXPECT_EQ(loaded.camera.depth_threshold, 3.5);
+  EXPECT_EQ(loaded.camera.depth_noise, CameraConfig::DepthNoise::kinect_v1);
+  EXPECT_EQ(loaded.camera.depth_noise_scale, 1.5);
   EXPECT_EQ(loaded.orb.n_features, 1500);
   EXPECT_EQ(loaded.orb.scale_factor, 1.3);
   EXPECT_EQ(loaded.orb.n_levels, 6);
@@ -117,6 +121,8 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
   EXPECT_EQ(config.camera.pinhole.fy, 501.25);
   EXPECT_EQ(config.camera.pinhole.distortion[4], 0.0);
   EXPECT_EQ(config.orb.n_features, 1000);
+  // Without the key, depth is weighed as ORB-SLAM2 does (virtual right coordinate).
+  EXPECT_EQ(config.camera.depth_noise, CameraConfig::DepthNoise::none);
 }
 
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
@@ -154,6 +160,13 @@ TEST(Config, InvalidValues) {
                 ": key 'camera.distortion' must list 4 or 5 values (k1 k2 p1 p2 [k3]), got 2");
   const auto scale = write_file(dir, std::string(kValidCamera) + "orb:\n  scale_factor: 1.0\n");
   EXPECT_EQ(load_error(scale), scale.string() + ": key 'orb.scale_factor' must be > 1");
+  const auto noise = write_file(dir, std::string(kValidCamera) + "  depth_noise: kinect\n");
+  EXPECT_EQ(load_error(noise),
+            noise.string() + ": key 'camera.depth_noise' must be none or kinect_v1, got 'kinect'");
+  const auto noise_scale =
+      write_file(dir, std::string(kValidCamera) + "  depth_noise_scale: 0\n");
+  EXPECT_EQ(load_error(noise_scale),
+            noise_scale.string() + ": key 'camera.depth_noise_scale' must be > 0");
   const auto broken = write_file(dir, "camera: [1, 2\n");
   EXPECT_EQ(load_error(broken).rfind(broken.string() + ":2: invalid YAML: ", 0), 0u)
       << load_error(broken);

@@ -37,6 +37,14 @@ CameraConfig read_camera(YamlSection section) {
   camera.fps = section.required<double>("fps");
   camera.depth_factor = section.required<double>("depth_factor");
   camera.depth_threshold = section.required<double>("depth_threshold");
+  const auto depth_noise = section.optional<std::string>("depth_noise", "none");
+  if (depth_noise == "kinect_v1") {
+    camera.depth_noise = CameraConfig::DepthNoise::kinect_v1;
+  } else if (depth_noise != "none") {
+    throw Error(section.file() + ": key '" + section.qualified("depth_noise") +
+                "' must be none or kinect_v1, got '" + depth_noise + "'");
+  }
+  camera.depth_noise_scale = section.optional("depth_noise_scale", camera.depth_noise_scale);
   require_positive(p.width, section, "width");
   require_positive(p.height, section, "height");
   require_positive(p.fx, section, "fx");
@@ -44,6 +52,7 @@ CameraConfig read_camera(YamlSection section) {
   require_positive(camera.fps, section, "fps");
   require_positive(camera.depth_factor, section, "depth_factor");
   require_positive(camera.depth_threshold, section, "depth_threshold");
+  require_positive(camera.depth_noise_scale, section, "depth_noise_scale");
   section.finish();
   return camera;
 }
@@ -101,6 +110,9 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "fps" << YAML::Value << config.camera.fps;
   out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
   out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
+  out << YAML::Key << "depth_noise" << YAML::Value
+      << (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1 ? "kinect_v1" : "none");
+  out << YAML::Key << "depth_noise_scale" << YAML::Value << config.camera.depth_noise_scale;
   out << YAML::EndMap;
   out << YAML::Key << "orb" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "n_features" << YAML::Value << config.orb.n_features;

@@ -14,6 +14,15 @@ struct CameraConfig {
   double fps = 30.0;
   double depth_factor = 5000.0;   // depth image units per metre (5000 for TUM and Bonn)
   double depth_threshold = 4.0;   // metres: closer points are "close" (reliable) points
+  // How a depth reading is weighed against the pixel in pose optimisation and bundle adjustment
+  // (optional keys `depth_noise: none | kinect_v1`, `depth_noise_scale`). none: ORB-SLAM2's
+  // virtual right coordinate, as firm as a pixel (robust to depth that is misregistered or out of
+  // sync with colour, as in bonn_crowd_dev). kinect_v1: a disparity row whitened by the Kinect v1
+  // axial noise model times depth_noise_scale (optimize/depth_noise_model.h); right for depth
+  // registered and synchronised with colour, e.g. the synthetic sequences.
+  enum class DepthNoise { none, kinect_v1 };
+  DepthNoise depth_noise = DepthNoise::none;
+  double depth_noise_scale = 2.0;
 };
 
 // ORB extractor parameters as ORB-SLAM2 defines them (YAML section `orb:`, all optional).

@@ -129,6 +129,8 @@ void OrbExtractor::build_pyramid(const cv::Mat& gray) {
     const cv::Rect inner(kLevelBorder, kLevelBorder, size.width, size.height);
     pyramid_level.image = pyramid_level.padded(inner);
     pyramid_level.blurred = pyramid_level.blurred_padded(inner);
+    pyramid_level.scale_x = static_cast<float>(gray.cols) / static_cast<float>(size.width);
+    pyramid_level.scale_y = static_cast<float>(gray.rows) / static_cast<float>(size.height);
 
     // Each level is resized from the previous one (cheaper than from level 0 and what ORB-SLAM2
     // does); the resize writes straight into the view inside the padded buffer.
@@ -148,20 +150,21 @@ void OrbExtractor::build_pyramid(const cv::Mat& gray) {
 }
 
 bool OrbExtractor::is_ignored(const cv::Mat& ignore_mask, float level_x, float level_y,
-                              float scale) const {
+                              const PyramidLevel& level) const {
   if (ignore_mask.empty()) return false;
   // Tested on the level-0 mask at the keypoint's level-0 position rather than on a resized mask:
   // a down-sampled mask can lose thin masked strips, and this is the exact criterion the
   // returned keypoint has to meet anyway.
-  const int x = std::clamp(static_cast<int>(std::lround(level_x * scale)), 0, ignore_mask.cols - 1);
-  const int y = std::clamp(static_cast<int>(std::lround(level_y * scale)), 0, ignore_mask.rows - 1);
+  const int x = std::clamp(static_cast<int>(std::lround((level_x + 0.5f) * level.scale_x - 0.5f)),
+                           0, ignore_mask.cols - 1);
+  const int y = std::clamp(static_cast<int>(std::lround((level_y + 0.5f) * level.scale_y - 0.5f)),
+                           0, ignore_mask.rows - 1);
   return ignore_mask.ptr<std::uint8_t>(y)[x] != 0;
 }
 
 void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
   candidates_.clear();
   const cv::Mat& image = pyramid_[level].image;
-  const float scale = scale_factors_[level];
   const int region_width = image.cols - 2 * kFastBorder;
   const int region_height = image.rows - 2 * kFastBorder;
   if (region_width <= 0 || region_height <= 0) return;
@@ -178,7 +181,7 @@ void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
   // are all masked still falls back to weak ones.
   cv::FAST(image, fast_keypoints_, config_.initial_fast_threshold, true);
   for (const cv::KeyPoint& keypoint : fast_keypoints_) {
-    if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, scale)) continue;
+    if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, pyramid_[level])) continue;
     const int col = (static_cast<int>(keypoint.pt.x) - kFastBorder) / cell_width;
     const int row = (static_cast<int>(keypoint.pt.y) - kFastBorder) / cell_height;
     ++cell_counts_[static_cast<std::size_t>(row) * n_cols + col];
@@ -209,7 +212,7 @@ void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
       for (cv::KeyPoint keypoint : fast_keypoints_) {
         keypoint.pt.x += static_cast<float>(window.x);
         keypoint.pt.y += static_cast<float>(window.y);
-        if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, scale)) continue;
+        if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, pyramid_[level])) continue;
         candidates_.push_back(keypoint);
       }
     }
@@ -308,8 +311,10 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
   out.descriptors.create(static_cast<int>(out.keypoints.size()), kOrbDescriptorBytes, CV_8UC1);
   for (int i = 0; i < static_cast<int>(out.keypoints.size()); ++i) {
     cv::KeyPoint& keypoint = out.keypoints[i];
-    describe(pyramid_[keypoint.octave].blurred, keypoint, out.descriptors.ptr<std::uint8_t>(i));
-    keypoint.pt *= scale_factors_[keypoint.octave];
+    const PyramidLevel& level = pyramid_[keypoint.octave];
+    describe(level.blurred, keypoint, out.descriptors.ptr<std::uint8_t>(i));
+    keypoint.pt.x = (keypoint.pt.x + 0.5f) * level.scale_x - 0.5f;
+    keypoint.pt.y = (keypoint.pt.y + 0.5f) * level.scale_y - 0.5f;
   }
 }
 

@@ -66,13 +66,19 @@ class OrbExtractor {
     cv::Mat image;           // view of padded without the border
     cv::Mat blurred_padded;  // padded, Gaussian-smoothed (outer 3 px unset): BRIEF runs on it
     cv::Mat blurred;         // view of blurred_padded without the border
+    // Level -> level-0 pixel coordinates: cv::resize aligns pixel centres, so
+    // x0 = (x + 0.5) * scale_x - 0.5 with scale_x = level-0 width / this width (not the nominal
+    // scale factor: sizes are rounded). Plain x * scale would shift level-7 keypoints by ~1.3 px.
+    float scale_x = 1.0f;
+    float scale_y = 1.0f;
   };
 
   void build_pyramid(const cv::Mat& gray);
   // FAST candidates of one level that are not masked; cells without any corner at the initial
   // threshold are searched again with the minimum threshold.
   void detect_candidates(int level, const cv::Mat& ignore_mask);
-  bool is_ignored(const cv::Mat& ignore_mask, float level_x, float level_y, float scale) const;
+  bool is_ignored(const cv::Mat& ignore_mask, float level_x, float level_y,
+                  const PyramidLevel& level) const;
   float orientation_degrees(const cv::Mat& image, const cv::Point2f& position) const;
   void describe(const cv::Mat& blurred, const cv::KeyPoint& keypoint,
                 std::uint8_t* descriptor) const;

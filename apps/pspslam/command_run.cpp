@@ -32,7 +32,9 @@
 #include "pspslam/eval/ate.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/map/map.h"
 #include "pspslam/semantic/segmenter_metadata.h"
+#include "pspslam/system/map_export.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam::cli {
@@ -153,6 +155,25 @@ std::ofstream open_output(const std::filesystem::path& file) {
   return stream;
 }
 
+// --export-map / --export-dense, after shutdown (local mapping has refined the poses).
+void write_map_exports(const ArgParser& parser, const MapExporter& exporter, const Map& map) {
+  const std::vector<std::string> comment = {"pspslam static map, world frame (metres)"};
+  for (const char* flag : {"export-map", "export-dense"}) {
+    if (!parser.has(flag)) continue;
+    const std::filesystem::path file = parser.get(flag);
+    const std::vector<ColoredPoint> cloud = std::string(flag) == "export-map"
+                                                ? exporter.map_points(map)
+                                                : exporter.dense_cloud(map, DenseCloudOptions{});
+    write_point_cloud_ply(file, cloud, comment);
+    std::cout << "map export:   " << file.string() << " (" << cloud.size() << " points"
+              << (std::string(flag) == "export-dense"
+                      ? ", from " + std::to_string(exporter.remembered_keyframes()) +
+                            " keyframe images"
+                      : std::string())
+              << ")\n";
+  }
+}
+
 }  // namespace
 
 int run_command(const std::vector<std::string>& args) {
@@ -177,7 +198,9 @@ int run_command(const std::vector<std::string>& args) {
                     "models/pspnet/pspnet.yaml");
   parser.add_switch("realtime",
                     "feed frames at the sequence's rate (late frames are dropped) and never wait "
-                    "for segmentation: use the newest mask, warped into the frame");
+                    "for segmentation or local mapping: use the newest mask, warped into the frame "
+                    "(default: deterministic, each frame waits for its mask and for local "
+                    "mapping to finish the previous keyframe)");
   parser.add_option("mask-margin", "dilation of the semantic dynamic mask (pixels)", "5");
   parser.add_option("vocabulary",
                     "ORB bag-of-words vocabulary for relocalisation (relative: to the source "
@@ -185,6 +208,10 @@ int run_command(const std::vector<std::string>& args) {
                     "models/vocabulary/orb_k10_l5.pspvoc");
   parser.add_switch("no-relocalization",
                     "do not relocalise when tracking is lost (and do not load the vocabulary)");
+  parser.add_option("loop-closing",
+                    "on | off | auto: loop closing thread (detection, essential-graph correction, "
+                    "global BA); auto = on when the vocabulary file exists",
+                    "auto");
   parser.add_option("save-map",
                     "write the final map to this file (binary, see docs/place_recognition.md)");
   parser.add_option("load-map", "start from this saved map: the first frame is relocalised in it");
@@ -193,12 +220,15 @@ int run_command(const std::vector<std::string>& args) {
   parser.add_option("blackout",
                     "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
                     "(tracking is lost for real; tests relocalisation)");
-  parser.add_option("loop-closing",
-                    "on | off | auto: loop closing thread (detection, essential-graph correction, "
-                    "global BA); auto = on when the vocabulary file exists",
-                    "auto");
   parser.add_option("cull-hits",
                     "erase a map point after it lay on dynamic pixels in this many frames", "3");
+  parser.add_option("export-map",
+                    "write the final static map points as a PLY point cloud (dynamic points never "
+                    "enter the map or are culled from it)");
+  parser.add_option(
+      "export-dense",
+      "also write a dense PLY cloud back-projected from the keyframes' depth at their "
+      "final poses, dynamic pixels left out (1 cm voxels, every 4th pixel)");
   if (!parser.parse(args)) return 0;
   const int max_frames_flag = parser.get_int("max-frames");
   // Assigned, not built by a conditional expression: GCC 12 then reports a false
@@ -231,6 +261,7 @@ int run_command(const std::vector<std::string>& args) {
 
   SystemOptions system_options;
   system_options.local_mapping = !parser.flag("no-local-mapping");
+  system_options.synchronous_local_mapping = !parser.flag("realtime");
   DynamicOptions& dynamic = system_options.dynamic;
   dynamic.model = parser.get("model");
   if (dynamic.model.is_relative()) dynamic.model = source_dir() / dynamic.model;
@@ -263,6 +294,8 @@ int run_command(const std::vector<std::string>& args) {
       parse_loop_closing(parser.get("loop-closing"), system_options.place.vocabulary);
   std::cout << "loop closing: " << (system_options.place.loop_closing ? "on" : "off") << "\n";
   System system(setup.config, system_options);
+  std::optional<MapExporter> exporter;
+  if (parser.has("export-map") || parser.has("export-dense")) exporter.emplace(camera);
   InterruptGuard interrupt_guard;
   ProgressBar progress("slam", frames, std::cerr);
   std::vector<double> extraction_ms;
@@ -329,6 +362,9 @@ int run_command(const std::vector<std::string>& args) {
     }
     const FrameReport report = system.process(frame);
     const TrackResult& result = report.tracking;
+    if (exporter && result.keyframe_inserted)
+      exporter->remember_keyframe(system.map().max_keyframe_id(), frame.bgr, frame.depth,
+                                  system.last_dynamic_mask());
     if (result.method == TrackingMethod::kRelocalisation) ++relocalisations;
     if (blackout && i >= blackout->end() && !first_pose_after_blackout && result.T_world_camera) {
       first_pose_after_blackout = i;
@@ -404,6 +440,7 @@ int run_command(const std::vector<std::string>& args) {
   const Trajectory refined = system.refined_trajectory();
   write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
   const MappingStats mapping = system.mapping_stats();
+  if (exporter) write_map_exports(parser, *exporter, system.map());
 
   char line[512];
   std::snprintf(line, sizeof(line),

@@ -50,6 +50,7 @@
 #include <chrono>
 #include <ctime>
 #include <deque>
+#include <limits>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -61,13 +62,13 @@
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
 #include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
-#include "pspslam/loop/loop_closing.h"
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
@@ -270,6 +271,9 @@ class System::DynamicPipeline {
   void reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
     if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
   }
+  // The fused semantic + geometry mask of the frame end_frame() finished last.
+  const cv::Mat& fused_mask() const { return previous_mask_; }
+
   // Step 6 and the state for the next frame.
   void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
                  DynamicReport& report) {
@@ -393,11 +397,21 @@ System::System(const SystemConfig& config, SystemOptions options)
   if (options.local_mapping) {
     LocalMappingOptions mapping_options;
     mapping_options.close_depth = config.camera.depth_threshold;
+    // The BA's wall-clock budget keeps a live system responsive; a synchronous run bounds BA by
+    // its iteration counts only, so its result does not depend on the machine's load.
+    if (options.synchronous_local_mapping)
+      mapping_options.bundle_adjustment.max_seconds = std::numeric_limits<double>::infinity();
+    if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
+      mapping_options.bundle_adjustment.depth_noise = {.enabled = true,
+                                                       .scale = config.camera.depth_noise_scale};
     mapping = std::make_unique<LocalMapping>(map_, mapping_options, place_);
   }
   mapping_ = std::make_unique<MappingConnection>(std::move(mapping), place_);
   // ORB-SLAM2 wants a keyframe at least once per second of video.
   options.tracker.keyframes.max_frames_between = static_cast<int>(config.camera.fps);
+  if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
+    options.tracker.pose_optimizer.depth_noise = {.enabled = true,
+                                                  .scale = config.camera.depth_noise_scale};
   tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker,
                                        options.place.relocalization ? place_ : nullptr);
   if (!options.map_file.empty()) {
@@ -410,6 +424,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     }
     tracker_->start_in_loaded_map();
   }
+  synchronous_local_mapping_ = options.synchronous_local_mapping;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     // The callback runs on a loop closing thread with Map::update_mutex() held, so the tracker
     // (which holds it for a whole frame) is never re-anchored in the middle of a frame.
@@ -449,6 +464,7 @@ FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Ma
   report.extraction_ms = milliseconds_since(start);
   const double cpu_tracking_start = thread_cpu_ms();
   report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
+  wait_for_local_mapping_if_synchronous(report);
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(frame));
   report.tracking_ms = milliseconds_since(tracking_start);
@@ -488,6 +504,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   report.extraction_ms += milliseconds_since(frame_start);
   report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
 
+  wait_for_local_mapping_if_synchronous(report);
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
@@ -496,6 +513,15 @@ FrameReport System::process(const RgbdFrame& frame) {
   dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
   return report;
 }
+
+void System::wait_for_local_mapping_if_synchronous(FrameReport& report) {
+  if (!synchronous_local_mapping_) return;
+  const auto start = std::chrono::steady_clock::now();
+  mapping_->wait_until_idle();
+  report.mapping_wait_ms = milliseconds_since(start);
+}
+
+cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }
 
 void System::shutdown() {
   if (loop_closing_ && mapping_->local_mapping() != nullptr) {

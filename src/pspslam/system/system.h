@@ -50,7 +50,6 @@ struct PlaceOptions {
   // Relocalise a lost tracker against the keyframe database. Needs the vocabulary, which is
   // then loaded (~0.1 s) and every keyframe gets a BoW vector in local mapping.
   bool relocalization = true;
-
   // Loop closing thread (`pspslam run --loop-closing`): detection, correction, global BA.
   // Needs the vocabulary and local mapping.
   bool loop_closing = true;
@@ -65,6 +64,11 @@ struct SystemOptions {
   TrackerOptions tracker;
   // false: keyframes go into the map but no local mapping runs (tests, debugging).
   bool local_mapping = true;
+  // true: a frame is tracked only once local mapping has finished the keyframes before it
+  // (extraction still overlaps). Offline accuracy runs want this: without it the map a frame
+  // is tracked against, and whether a keyframe is accepted, depend on how fast this machine is
+  // right now (a fast, unpaced run outruns local BA). A live camera wants false.
+  bool synchronous_local_mapping = false;
   DynamicOptions dynamic;
   PlaceOptions place;
   // Map file to start from (`pspslam run --load-map`, persistence/map_file.h); empty: start a
@@ -97,6 +101,7 @@ struct FrameReport {
   TrackResult tracking;
   double extraction_ms = 0.0;
   double tracking_ms = 0.0;
+  double mapping_wait_ms = 0.0;  // synchronous_local_mapping: waited for local mapping
   // CPU time of the calling thread: on a shared, loaded machine wall time includes waiting
   // for a core, CPU time does not.
   double extraction_cpu_ms = 0.0;
@@ -153,6 +158,11 @@ class System {
   // adjustment, then stops their threads. Idempotent.
   void shutdown();
 
+  // The fused dynamic mask (semantic + geometry, CV_8UC1, non-zero = dynamic) of the frame
+  // process() handled last; empty with DynamicMode::off or before the first mask. Shared, not
+  // copied: the next process() replaces it rather than writing into it.
+  cv::Mat last_dynamic_mask() const;
+
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
   // Returns the number of keyframes and map points written.
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
@@ -172,6 +182,8 @@ class System {
   class MappingConnection;
   class DynamicPipeline;
 
+  void wait_for_local_mapping_if_synchronous(FrameReport& report);
+
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   std::unique_ptr<OrbExtractor> extractor_;
@@ -190,6 +202,7 @@ class System {
   std::uint64_t map_corrections_ = 0;
   std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
+  bool synchronous_local_mapping_ = false;
   DynamicOptions dynamic_options_;
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker and map go away.

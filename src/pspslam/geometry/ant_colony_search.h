@@ -23,8 +23,9 @@ struct AntColonyParams {
   float band_width_px = 80.0f;     // dZ: band around a community's convex hull tested per round
   float node_spacing_px = 16.0f;   // s: distance between consecutive nodes along a lane
   // Distance between the horizontal boustrophedon lanes of the path L. Lanes run across the
-  // image, so a standing person (120+ px tall up to ~4 m away) always crosses one of them.
-  float lane_spacing_px = 96.0f;
+  // image, so a standing person (~220 px tall at 4 m; the gap between lane bands is
+  // 128 - 2R = 104 px) always crosses one of them; alternate_lanes halves the gap over 2 frames.
+  float lane_spacing_px = 128.0f;
   // Shift the lanes by half a lane spacing on every other run(): a mover the path passes by in
   // one frame lies on a lane of the next one, and once found it is followed by the priority
   // points (previous mask) instead of the path.

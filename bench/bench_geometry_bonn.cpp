@@ -17,11 +17,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -69,7 +69,7 @@ double percentile(std::vector<double> v, double p) {
 
 struct Frame {
   double timestamp = 0.0;
-  std::optional<Pose> T_world_camera;  // from --poses
+  std::optional<Pose> T_world_camera;      // from --poses
   cv::Mat depth;                           // undistorted, metres
   std::vector<Eigen::Vector2d> keypoints;  // undistorted pixels with a depth reading
   std::vector<float> depths;
@@ -118,9 +118,10 @@ int main(int argc, char** argv) {
     Frame f;
     f.timestamp = rgb[i].t;
     if (!poses.empty()) {
-      const auto pose = std::min_element(poses.begin(), poses.end(), [&](const auto& a, const auto& b) {
-        return std::abs(a.timestamp - rgb[i].t) < std::abs(b.timestamp - rgb[i].t);
-      });
+      const auto pose =
+          std::min_element(poses.begin(), poses.end(), [&](const auto& a, const auto& b) {
+            return std::abs(a.timestamp - rgb[i].t) < std::abs(b.timestamp - rgb[i].t);
+          });
       if (std::abs(pose->timestamp - rgb[i].t) < 0.005) f.T_world_camera = pose->T_world_camera;
     }
     cv::Mat metres;

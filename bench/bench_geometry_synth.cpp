@@ -130,12 +130,10 @@ Counts run(const GeometryParams& params, const PinholeCamera& camera,
 void diagnose(const GeometryParams& params, const PinholeCamera& camera,
               const std::vector<Frame>& frames) {
   MultiViewTest test(camera, params.multiview);
-  ReferenceSelector selector(camera, {params.multiview.max_reference_views,
-                                      params.references.wanted_coverage,
-                                      params.references.point_stride,
-                                      params.multiview.reference_patch_radius,
-                                      params.multiview.max_parallax_deg,
-                                      params.references.older_view_gain_share});
+  ReferenceSelector selector(
+      camera, {params.multiview.max_reference_views, params.references.wanted_coverage,
+               params.references.point_stride, params.multiview.reference_patch_radius,
+               params.multiview.max_parallax_deg, params.references.older_view_gain_share});
   long dynamic = 0, caught = 0, no_valid = 0, all_refs_on_mover = 0, some_static = 0;
   long mostly_closer = 0;
   std::vector<CandidatePoint> candidates;
@@ -298,7 +296,8 @@ int main(int argc, char** argv) {
         for (size_t index : reference_frames) {
           const SynthFrame& ref = cache.get(index);
           f.references.push_back(
-              {perturbed(ref.T_world_camera, o.pose_noise_mm, o.pose_noise_deg, rng), ref.depth_sensor});
+              {perturbed(ref.T_world_camera, o.pose_noise_mm, o.pose_noise_deg, rng),
+               ref.depth_sensor});
           f.reference_labels.push_back(ref.labels);
         }
         const SynthFrame& now = cache.get(current);
@@ -335,7 +334,8 @@ int main(int argc, char** argv) {
             y.emplace_back(b.x, b.y);
           }
           if (x.size() >= 8) {
-            const CompensatedHomography h = estimate_compensated_homography(x, y, params.homography);
+            const CompensatedHomography h =
+                estimate_compensated_homography(x, y, params.homography);
             f.have_H = h.valid;
             if (h.valid) f.H_previous_to_current = h.H;
           }

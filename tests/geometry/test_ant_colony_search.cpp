@@ -55,8 +55,8 @@ PlantedSet make_set(Density density, std::uint64_t seed) {
       if ((set.points[i] - centre).cwiseQuotient(semi_axes).norm() < 1.0f) set.cluster[i] = c;
     for (int k = 0; k < per_cluster; ++k) {
       const float r = std::sqrt(unit(rng)), angle = 6.2831853f * unit(rng);
-      set.points.push_back(centre + r * semi_axes.cwiseProduct(
-                                            Eigen::Vector2f(std::cos(angle), std::sin(angle))));
+      set.points.push_back(
+          centre + r * semi_axes.cwiseProduct(Eigen::Vector2f(std::cos(angle), std::sin(angle))));
       set.cluster.push_back(c);
     }
   }

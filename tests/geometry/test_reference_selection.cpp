@@ -11,7 +11,8 @@ namespace {
 // (every view's depth image is the constant 3 m: only which pixels project inside matters here).
 Pose turned(double yaw_deg) {
   Pose T = Pose::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T.linear() =
+      Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   return T;
 }
 
@@ -44,10 +45,11 @@ TEST(ReferenceSelection, CoversTheStripThatTheMostOverlappingViewsAllMiss) {
   for (const CandidatePoint& point : points) {
     bool seen = false;
     for (int v : chosen) {
-      const Eigen::Vector3d p = pool[v].T_world_camera.inverse() * camera.unproject(point.pixel, 3.0);
+      const Eigen::Vector3d p =
+          pool[v].T_world_camera.inverse() * camera.unproject(point.pixel, 3.0);
       const Eigen::Vector2d pixel = camera.project(p);
-      seen = seen || (p.z() > 0 && pixel.x() >= 4 && pixel.y() >= 4 && pixel.x() < 636 &&
-                      pixel.y() < 476);
+      seen = seen ||
+             (p.z() > 0 && pixel.x() >= 4 && pixel.y() >= 4 && pixel.x() < 636 && pixel.y() < 476);
     }
     unseen += !seen;
   }
@@ -58,7 +60,8 @@ TEST(ReferenceSelection, SmallPoolIsPassedThroughAndOlderViewsWinNearTies) {
   const PinholeCamera camera;
   const cv::Mat wall(480, 640, CV_32FC1, cv::Scalar(3.0f));
   const std::vector<CandidatePoint> points = grid_candidates(3.0);
-  std::vector<DepthView> pool = {{turned(1.0), wall}, {turned(2.0), wall}, {turned(3.0), cv::Mat()}};
+  std::vector<DepthView> pool = {
+      {turned(1.0), wall}, {turned(2.0), wall}, {turned(3.0), cv::Mat()}};
   ReferenceSelector selector(camera, {});
   // Not more views than wanted: all views with a depth image, in pool order.
   EXPECT_EQ(selector.select(turned(0.0), points, pool), (std::vector<int>{0, 1}));

@@ -246,10 +246,14 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   const float radius2 = params_.search_radius_px * params_.search_radius_px;
   for (const Eigen::Vector2f& node : path_nodes_[phase]) {
     const float radius = params_.search_radius_px;
-    const int col0 = std::clamp(static_cast<int>((node.x() - radius) / cell_size_), 0, grid_cols_ - 1);
-    const int col1 = std::clamp(static_cast<int>((node.x() + radius) / cell_size_), 0, grid_cols_ - 1);
-    const int row0 = std::clamp(static_cast<int>((node.y() - radius) / cell_size_), 0, grid_rows_ - 1);
-    const int row1 = std::clamp(static_cast<int>((node.y() + radius) / cell_size_), 0, grid_rows_ - 1);
+    const int col0 =
+        std::clamp(static_cast<int>((node.x() - radius) / cell_size_), 0, grid_cols_ - 1);
+    const int col1 =
+        std::clamp(static_cast<int>((node.x() + radius) / cell_size_), 0, grid_cols_ - 1);
+    const int row0 =
+        std::clamp(static_cast<int>((node.y() - radius) / cell_size_), 0, grid_rows_ - 1);
+    const int row1 =
+        std::clamp(static_cast<int>((node.y() + radius) / cell_size_), 0, grid_rows_ - 1);
     found_.clear();
     const auto near_node = [&](const Eigen::Vector2f& p) {
       return (p - node).squaredNorm() <= radius2;

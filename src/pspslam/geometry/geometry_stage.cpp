@@ -67,10 +67,10 @@ GeometryStage::GeometryStage(PinholeCamera camera, GeometryParams params)
     : camera_(camera),
       params_(params),
       test_(camera, params.multiview),
-      selector_(camera, {params.multiview.max_reference_views, params.references.wanted_coverage,
-                         params.references.point_stride, params.multiview.reference_patch_radius,
-                         params.multiview.max_parallax_deg,
-                         params.references.older_view_gain_share}),
+      selector_(camera,
+                {params.multiview.max_reference_views, params.references.wanted_coverage,
+                 params.references.point_stride, params.multiview.reference_patch_radius,
+                 params.multiview.max_parallax_deg, params.references.older_view_gain_share}),
       search_(params.search),
       grower_(params.region, static_cast<float>(camera.fx)) {}
 

@@ -64,7 +64,7 @@ struct GeometryFrameInput {
 struct GeometryTiming {
   double homography_ms = 0.0;
   double selection_ms = 0.0;  // choice of the reference views from a larger pool
-  double search_ms = 0.0;  // ant-colony (or exhaustive) search including the multi-view tests
+  double search_ms = 0.0;     // ant-colony (or exhaustive) search including the multi-view tests
   double region_ms = 0.0;
   double total_ms = 0.0;
   double homography_cpu_ms = 0.0;

@@ -25,9 +25,10 @@ const cv::Mat& ReferenceSelector::validity(const cv::Mat& depth) {
   // A keyframe stays in the pool for many frames: its map is built once. The cache holds a
   // shallow copy of the depth image, so the buffer (and thus its address) cannot be reused
   // while the entry exists.
-  CachedView view{depth, cv::Mat((depth.rows + kBlock - 1) / kBlock,
-                                 (depth.cols + kBlock - 1) / kBlock, CV_8UC1),
-                  true};
+  CachedView view{
+      depth,
+      cv::Mat((depth.rows + kBlock - 1) / kBlock, (depth.cols + kBlock - 1) / kBlock, CV_8UC1),
+      true};
   for (int by = 0; by < view.valid.rows; ++by) {
     const float* row = depth.ptr<float>(std::min(by * kBlock + kBlock / 2, depth.rows - 1));
     std::uint8_t* out = view.valid.ptr<std::uint8_t>(by);
@@ -52,7 +53,8 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
   const size_t stride = static_cast<size_t>(std::max(1, params_.point_stride));
   sampled_.clear();
   for (size_t i = 0; i < points.size(); i += stride) {
-    if (points[i].depth > 0.0) sampled_.push_back(camera_.unproject(points[i].pixel, points[i].depth));
+    if (points[i].depth > 0.0)
+      sampled_.push_back(camera_.unproject(points[i].pixel, points[i].depth));
   }
   const size_t sampled = sampled_.size();
   seen_.assign(static_cast<size_t>(views) * sampled, 0);
@@ -79,7 +81,8 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
       if (!(pixel.x() >= border && pixel.y() >= border && pixel.x() < depth.cols - border &&
             pixel.y() < depth.rows - border))
         continue;
-      if (!valid.ptr<std::uint8_t>(static_cast<int>(pixel.y()) / kBlock)[static_cast<int>(pixel.x()) / kBlock])
+      if (!valid.ptr<std::uint8_t>(static_cast<int>(pixel.y()) /
+                                   kBlock)[static_cast<int>(pixel.x()) / kBlock])
         continue;
       const Eigen::Vector3d ray = p - centre;
       if (p.dot(ray) < cos_max_parallax * p.norm() * ray.norm()) continue;

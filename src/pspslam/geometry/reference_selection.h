@@ -13,10 +13,11 @@ namespace pspslam {
 // keyframes") from a larger pool. Greedy coverage: the first pick is the view that sees the most
 // candidate points (DynaSLAM's rule); every further pick maximises the candidates it adds that
 // fewer than `wanted_coverage` picks see yet, preferring older views among nearly equal gains;
-// once all are covered that often, the remaining picks go by plain overlap. Why not the top-k by overlap: after a camera turn
-// the k most overlapping views all miss the same newly visible strip, and a point no reference
-// sees can never be found dynamic (docs/geometry.md, diagnosis of the synthetic misses).
-// Reusable scratch buffers and a per-view cache; not thread-safe, one per worker thread.
+// once all are covered that often, the remaining picks go by plain overlap. Why not the top-k by
+// overlap: after a camera turn the k most overlapping views all miss the same newly visible strip,
+// and a point no reference sees can never be found dynamic (docs/geometry.md, diagnosis of the
+// synthetic misses). Reusable scratch buffers and a per-view cache; not thread-safe, one per worker
+// thread.
 class ReferenceSelector {
  public:
   // A candidate is "seen" by a view when it projects inside the view (with `border_px` margin)

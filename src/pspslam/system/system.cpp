@@ -282,7 +282,10 @@ class System::DynamicPipeline {
       if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
         // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
         references_.push_front({keyframe, depth});
-        const size_t keep = static_cast<size_t>(options_.geometry.multiview.max_reference_views);
+        // A pool larger than the views the test uses: the stage picks them by coverage of the
+        // frame (reference_selection.h), so a camera turn does not leave the image edge unseen.
+        const size_t keep = kReferencePoolFactor *
+                            static_cast<size_t>(options_.geometry.multiview.max_reference_views);
         while (references_.size() > keep) references_.pop_back();
       }
     }
@@ -345,6 +348,10 @@ class System::DynamicPipeline {
     // Constant velocity, as tracking's own motion model.
     return velocity_ ? *last_pose_ * *velocity_ : *last_pose_;
   }
+
+  // Reference pool = this many times the multi-view test's views (12-15 keyframe depths, ~1 MB
+  // each; docs/geometry.md measured the recall gain with a pool of 20 frames).
+  static constexpr size_t kReferencePoolFactor = 3;
 
   DynamicOptions options_;
   PinholeCamera camera_;

@@ -87,29 +87,29 @@ bool Relocalizer::try_candidate(Frame& frame, const std::shared_ptr<KeyFrame>& k
     histogram.add(keyframe->keypoints()[bow_matches_[m].query].angle,
                   frame.keypoints()[bow_matches_[m].train].angle, static_cast<int>(m));
   }
-  std::vector<std::uint8_t> rejected(bow_matches_.size(), 0);
-  for (const int m : histogram.rejected()) rejected[m] = 1;
-  std::vector<Eigen::Vector3d> points_world;
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<int> keypoint;
+  rejected_.assign(bow_matches_.size(), 0);
+  for (const int m : histogram.rejected()) rejected_[m] = 1;
+  points_world_.clear();
+  pixels_.clear();
+  keypoint_.clear();
   for (size_t m = 0; m < bow_matches_.size(); ++m) {
-    if (rejected[m]) continue;
+    if (rejected_[m]) continue;
     const int i = bow_matches_[m].train;
     frame.map_points[i] = points[bow_matches_[m].query];
-    points_world.push_back(frame.map_points[i]->position());
-    pixels.emplace_back(frame.keypoints()[i].pt.x, frame.keypoints()[i].pt.y);
-    keypoint.push_back(i);
+    points_world_.push_back(frame.map_points[i]->position());
+    pixels_.emplace_back(frame.keypoints()[i].pt.x, frame.keypoints()[i].pt.y);
+    keypoint_.push_back(i);
   }
-  if (static_cast<int>(keypoint.size()) < options_.min_bow_matches) return false;
+  if (static_cast<int>(keypoint_.size()) < options_.min_bow_matches) return false;
 
   PnpRansacOptions pnp_options;
   pnp_options.iterations = 300;
   pnp_options.min_inliers = options_.min_pnp_inliers;
   const PnpRansacResult pnp =
-      solve_pnp_ransac(frame.camera().pinhole, points_world, pixels, pnp_options);
+      solve_pnp_ransac(frame.camera().pinhole, points_world_, pixels_, pnp_options);
   if (!pnp.success) return false;
-  for (size_t k = 0; k < keypoint.size(); ++k) {
-    if (!pnp.inlier[k]) frame.map_points[keypoint[k]] = nullptr;
+  for (size_t k = 0; k < keypoint_.size(); ++k) {
+    if (!pnp.inlier[k]) frame.map_points[keypoint_[k]] = nullptr;
   }
   frame.set_pose(pnp.T_camera_world);
   inliers = optimize_and_prune(frame);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -71,6 +72,10 @@ class Relocalizer {
   // Reused buffers (relocalisation runs on consecutive lost frames).
   std::vector<std::uint8_t> keyframe_usable_;
   std::vector<BowMatch> bow_matches_;
+  std::vector<std::uint8_t> rejected_;         // by the rotation histogram, per BoW match
+  std::vector<Eigen::Vector3d> points_world_;  // PnP correspondences
+  std::vector<Eigen::Vector2d> pixels_;
+  std::vector<int> keypoint_;
   std::vector<PoseObservation> observations_;
   std::vector<int> observation_keypoint_;
   std::vector<ProjectedPoint> projected_;

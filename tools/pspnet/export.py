@@ -90,6 +90,8 @@ def main():
                         help="metadata file name written into models/pspnet/")
     parser.add_argument("--golden", action="store_true",
                         help="write models/pspnet/golden/ (input.png, labels.png, logits.txt)")
+    parser.add_argument("--out-dir", default=str(common.MODEL_DIR),
+                        help="where the ONNX, metadata and golden files go")
     parser.add_argument("--tolerance", type=float, default=1e-3,
                         help="max abs logit difference OpenCV vs PyTorch")
     args = parser.parse_args()
@@ -106,8 +108,10 @@ def main():
     model.backbone.phase_layout = model.backbone.phase_layout_pays((args.height // 8, args.width // 8))
     print(f"space-to-batch layout for the dilated stages: {model.backbone.phase_layout}")
 
+    out_dir = Path(args.out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
     onnx_name = f"pspnet_{args.width}x{args.height}.onnx"
-    onnx_path = common.MODEL_DIR / onnx_name
+    onnx_path = out_dir / onnx_name
     dummy = torch.zeros(1, 3, args.height, args.width)
     torch.onnx.export(model, dummy, str(onnx_path), opset_version=10, input_names=["input"],
                       output_names=["logits"], do_constant_folding=True)
@@ -139,11 +143,11 @@ def main():
         f"pspnet_mnv2_{state['width_multiplier']}", onnx_name, args.width, args.height,
         common.MEAN, common.STD,
         "Our compact PSPNet (tools/pspnet); see MODEL_CARD.md. Read by pspslam::OnnxSegmenter.")
-    (common.MODEL_DIR / args.yaml).write_text(yaml_text)
-    print(f"wrote {common.MODEL_DIR / args.yaml}")
+    (out_dir / args.yaml).write_text(yaml_text)
+    print(f"wrote {out_dir / args.yaml}")
 
     if args.golden:
-        golden = common.MODEL_DIR / "golden"
+        golden = out_dir / "golden"
         golden.mkdir(exist_ok=True)
         image = inputs[0][1]
         cv2.imwrite(str(golden / "input.png"), image)

@@ -1,8 +1,8 @@
 """Compact PSPNet (paper Fig. 2) on a dilated MobileNetV2 backbone.
 
-Backbone: MobileNetV2 1.0 with the strides of the last stages replaced by
-dilation (64/96-channel stages: dilation 2, 160/320-channel stages: dilation 4),
-so the final feature map is 1/8 of the input.  The backbone convolutions carry
+Backbone: MobileNetV2 with the strides of the last stages replaced by dilation
+(64/96-channel stages: dilation 2, 160/320-channel stages: dilation 4, or 2 with
+last_dilation=2 as shipped), so the final feature map is 1/8 of the input.  The backbone convolutions carry
 a bias and no batch-norm: the pretrained DeepLab v3 weights we start from have
 batch-norm folded into the convolutions already, so conv+bias reproduces them
 exactly and fine-tuning does not depend on small-batch statistics.

@@ -1,10 +1,13 @@
-"""Trains the compact PSPNet on CPU: human_seg person masks + teacher distillation.
+"""Trains the compact PSPNet (CPU; a CUDA GPU when present): human_seg person masks +
+teacher distillation.
 
 Loss per pixel (ignoring padding):
   * cross-entropy on hard labels: on human_seg, GT person -> class 15 and GT
     background -> the teachers' arg-max among the non-person classes; on frames
     without ground truth (bonn, synthetic) the teachers' arg-max (weight --pseudo-weight);
-  * KL(teacher || student) at temperature T, times T^2 (weight --kd-weight).
+  * KL(teacher || student) at temperature T, times T^2 (weight --kd-weight);
+  * optionally a soft-Jaccard person loss on the photos with GT (--iou-weight), since the
+    target metric is person IoU against those masks.
 Validation person IoU (mean over the fixed validation split, at photo
 resolution, same preprocessing as the C++ path) is logged every epoch.
 """

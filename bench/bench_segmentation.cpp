@@ -111,7 +111,8 @@ Options parse(int* argc, char** argv) {
   *argc = static_cast<int>(rest.size());
   if (o.models.empty()) {
     const fs::path src = pspslam::source_dir() / "models";
-    o.models = {src / "pspnet" / "pspnet.yaml", src / "pspnet" / "pspnet_384x288.yaml",
+    o.models = {src / "pspnet" / "pspnet.yaml",
+                src / "pspnet" / "pspnet_384x288.yaml",
                 src / "pspnet" / "pspnet_192x144.yaml",
                 src / "teachers" / "deeplabv3_mnv2_pascal.yaml",
                 src / "teachers" / "deeplabv3_mnv2_dm05_pascal.yaml",

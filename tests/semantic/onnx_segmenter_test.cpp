@@ -84,11 +84,11 @@ TEST(OnnxSegmenter, OutputShapeDisagreeingWithMetadataIsAnError) {
     segmenter.segment(cv::Mat(h, w, CV_8UC3, cv::Scalar::all(0)));
     FAIL() << "expected an Error";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()),
-              (kModelDir / "pspnet.yaml").string() + ": network output is 1x21x" +
-                  std::to_string(h) + "x" + std::to_string(w) + ", metadata says 1x21x" +
-                  std::to_string(h / 8) + "x" + std::to_string(w / 8) +
-                  " (classes, input / output.stride)");
+    EXPECT_EQ(std::string(e.what()), (kModelDir / "pspnet.yaml").string() +
+                                         ": network output is 1x21x" + std::to_string(h) + "x" +
+                                         std::to_string(w) + ", metadata says 1x21x" +
+                                         std::to_string(h / 8) + "x" + std::to_string(w / 8) +
+                                         " (classes, input / output.stride)");
   }
 }
 

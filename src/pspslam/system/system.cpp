@@ -21,7 +21,9 @@
 //                                (full) or every point (exhaustive); flagged keypoints and those
 //                                inside grown regions are dropped *before* the Frame exists, so
 //                                they are neither tracked nor turned into map points
-//                             5. Tracker::track() (holds Map::update_mutex() while it works)
+//                             5. Tracker::track() (holds Map::update_mutex() while it works);
+//                                deterministic runs first wait until local mapping is idle, so
+//                                the map a frame meets does not depend on the machine's speed
 //                             6. map points of the local map that project onto the fused mask
 //                                with matching depth are counted; repeat offenders are erased
 //                                  | KeyFrameSink::insert_keyframe (keyframe already in Map)

@@ -44,6 +44,7 @@ struct Options {
   int bodies = 3;
   int diagnose = 0;
   int repeats = 5;
+  int bookkeeping = 0;  // --bookkeeping 1: split the search time into its own cost and the tests
   double pose_noise_mm = 0.0;
   double pose_noise_deg = 0.0;
   std::vector<std::pair<std::string, double>> overrides;
@@ -81,14 +82,16 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Runs the stage over all frames in order, chaining each run's previous mask like System does.
-Counts run(const GeometryParams& params, const PinholeCamera& camera,
-           const std::vector<Frame>& frames, std::vector<std::uint8_t>* tested_dynamic,
-           std::vector<int>* per_seed_frame_fn = nullptr) {
-  Counts c;
-  GeometryStage stage(camera, params);
+// One strategy's stage over the frames in order, chaining each frame's previous mask like
+// System does.
+struct StrategyRun {
+  StrategyRun(const GeometryParams& params, const PinholeCamera& camera) : stage(camera, params) {}
+  GeometryStage stage;
   cv::Mat previous_mask;
-  for (const Frame& f : frames) {
+  Counts c;
+
+  void step(const Frame& f, std::vector<std::uint8_t>* tested_dynamic,
+            std::vector<std::vector<int>>* priorities) {
     GeometryFrameInput input;
     input.depth = f.depth;
     input.T_world_camera = f.T_world_camera;
@@ -97,9 +100,19 @@ Counts run(const GeometryParams& params, const PinholeCamera& camera,
     if (!f.run_start && !previous_mask.empty() && f.have_H)
       input.previous_dynamic_mask =
           warp_to_current(previous_mask, f.H_previous_to_current, f.depth.size(), true);
+    if (priorities) {
+      // The stage's priority points: inside the previous mask (no matches given here, so the
+      // stage maps pixels with the identity, as below).
+      std::vector<int>& priority = priorities->emplace_back();
+      const cv::Mat& mask = input.previous_dynamic_mask;
+      for (size_t i = 0; i < f.keypoints.size() && !mask.empty(); ++i) {
+        const int u = int(std::floor(f.keypoints[i].x())), v = int(std::floor(f.keypoints[i].y()));
+        if (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows && mask.at<std::uint8_t>(v, u))
+          priority.push_back(int(i));
+      }
+    }
     const GeometryFrameResult r = stage.process(input);
     previous_mask = r.dynamic_mask;
-    int fn = 0;
     for (size_t i = 0; i < f.keypoints.size(); ++i) {
       const bool truth = f.labels.at<std::uint8_t>(int(f.keypoints[i].y() + 0.5),
                                                    int(f.keypoints[i].x() + 0.5)) != 0;
@@ -107,13 +120,11 @@ Counts run(const GeometryParams& params, const PinholeCamera& camera,
       c.tp += truth && flag;
       c.fp += !truth && flag;
       c.fn += truth && !flag;
-      fn += truth && !flag;
       c.test_tp += truth && test;
       c.test_fp += !truth && test;
       c.test_fn += truth && !test;
       if (tested_dynamic) tested_dynamic->push_back(test);
     }
-    if (per_seed_frame_fn) per_seed_frame_fn->push_back(fn);
     c.tested += r.tested_count;
     c.points += long(f.keypoints.size());
     c.cpu_ms.push_back(r.timing.total_cpu_ms);
@@ -121,7 +132,28 @@ Counts run(const GeometryParams& params, const PinholeCamera& camera,
     c.selection_cpu_ms.push_back(r.timing.selection_cpu_ms);
     c.region_cpu_ms.push_back(r.timing.region_cpu_ms);
   }
-  return c;
+};
+
+// Both strategies frame by frame in one pass, so both see the same machine load; the one that
+// runs first on a frame reads the reference depth images out of cache, so the order alternates
+// (frame by frame, and between passes via `first_ant`).
+void run_both(const GeometryParams& ant, const GeometryParams& exhaustive,
+              const PinholeCamera& camera, const std::vector<Frame>& frames, bool first_ant,
+              Counts& ca, Counts& ce, std::vector<std::uint8_t>& flags_ant,
+              std::vector<std::uint8_t>& flags_exhaustive,
+              std::vector<std::vector<int>>& priorities) {
+  StrategyRun a(ant, camera), e(exhaustive, camera);
+  for (size_t k = 0; k < frames.size(); ++k) {
+    if ((k % 2 == 0) == first_ant) {
+      a.step(frames[k], &flags_ant, &priorities);
+      e.step(frames[k], &flags_exhaustive, nullptr);
+    } else {
+      e.step(frames[k], &flags_exhaustive, nullptr);
+      a.step(frames[k], &flags_ant, &priorities);
+    }
+  }
+  ca = std::move(a.c);
+  ce = std::move(e.c);
 }
 
 // Why does the multi-view test miss dynamic keypoints? Each ground-truth dynamic keypoint the
@@ -189,6 +221,92 @@ void diagnose(const GeometryParams& params, const PinholeCamera& camera,
       dynamic, caught, no_valid, all_refs_on_mover, mostly_closer, some_static);
 }
 
+double thread_cpu_ms() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return double(now.tv_sec) * 1e3 + double(now.tv_nsec) * 1e-6;
+}
+
+// Where does the search's time go? Replays each frame's search with the exhaustive run's verdicts
+// (a table look-up instead of the multi-view test) — the search's own cost — and times the real
+// test separately on dynamic and static points (with the references the stage selects). Thread
+// CPU medians per frame over `repeats` passes.
+void bookkeeping_report(const GeometryParams& params, const PinholeCamera& camera,
+                        const std::vector<Frame>& frames,
+                        const std::vector<std::uint8_t>& verdict_flags,
+                        const std::vector<std::vector<int>>& priorities, int repeats) {
+  std::vector<double> own_ant, own_exhaustive, test_dynamic_us, test_static_us;
+  std::vector<std::vector<double>> per_frame_ant(frames.size()), per_frame_exh(frames.size());
+  std::vector<Eigen::Vector2f> points;
+  long communities = 0, rounds = 0, runs = 0;
+  // The replay is cheap, so it is repeated 20x more often than the stage runs (steadier medians).
+  for (int pass = 0; pass < 20 * std::max(1, repeats); ++pass) {
+    AntColonyParams ant = params.search, exhaustive = params.search;
+    ant.strategy = SearchStrategy::ant_colony;
+    exhaustive.strategy = SearchStrategy::exhaustive;
+    DynamicPointSearch ant_search(ant), exhaustive_search(exhaustive);
+    size_t offset = 0;
+    for (size_t k = 0; k < frames.size(); ++k) {
+      const Frame& f = frames[k];
+      points.clear();
+      for (const Eigen::Vector2d& p : f.keypoints) points.push_back(p.cast<float>());
+      const std::uint8_t* verdicts = verdict_flags.data() + offset;
+      offset += f.keypoints.size();
+      const PointPredicate lookup = [verdicts](int i) { return verdicts[i] != 0; };
+      double t0 = thread_cpu_ms();
+      exhaustive_search.run(points, f.depth.size(), lookup);
+      per_frame_exh[k].push_back(thread_cpu_ms() - t0);
+      t0 = thread_cpu_ms();
+      const SearchResult& r = ant_search.run(points, f.depth.size(), lookup, priorities[k]);
+      per_frame_ant[k].push_back(thread_cpu_ms() - t0);
+      communities += r.communities;
+      rounds += r.band_rounds;
+      runs += 1;
+    }
+  }
+  for (size_t k = 0; k < frames.size(); ++k) {
+    own_ant.push_back(median(per_frame_ant[k]));
+    own_exhaustive.push_back(median(per_frame_exh[k]));
+  }
+  MultiViewTest test(camera, params.multiview);
+  ReferenceSelector selector(
+      camera, {params.multiview.max_reference_views, params.references.wanted_coverage,
+               params.references.point_stride, params.multiview.reference_patch_radius,
+               params.multiview.max_parallax_deg, params.references.older_view_gain_share});
+  std::vector<CandidatePoint> candidates;
+  std::vector<DepthView> views;
+  size_t offset = 0;
+  for (const Frame& f : frames) {
+    candidates.clear();
+    for (const Eigen::Vector2d& kp : f.keypoints)
+      candidates.push_back({kp, f.depth.at<float>(int(kp.y() + 0.5), int(kp.x() + 0.5))});
+    views.clear();
+    for (int v : selector.select(f.T_world_camera, candidates, f.references))
+      views.push_back(f.references[v]);
+    test.set_frame(f.T_world_camera, views);
+    for (int want = 0; want < 2; ++want) {
+      int count = 0, sink = 0;
+      const double t0 = thread_cpu_ms();
+      for (int pass = 0; pass < 5; ++pass) {
+        for (size_t i = 0; i < candidates.size(); ++i) {
+          if (verdict_flags[offset + i] != want) continue;
+          sink += test.is_dynamic(candidates[i]);
+          ++count;
+        }
+      }
+      const double us = (thread_cpu_ms() - t0) * 1e3 / std::max(1, count);
+      if (count > 0) (want ? test_dynamic_us : test_static_us).push_back(us + 0.0 * sink);
+    }
+    offset += f.keypoints.size();
+  }
+  std::printf(
+      "search's own cost (verdicts looked up), cpu median per frame: ant colony %.4f ms, "
+      "exhaustive %.4f ms (%.1f communities, %.1f band rounds per frame); multi-view test per "
+      "point: dynamic %.3f us, static %.3f us\n",
+      median(own_ant), median(own_exhaustive), double(communities) / std::max(1L, runs),
+      double(rounds) / std::max(1L, runs), median(test_dynamic_us), median(test_static_us));
+}
+
 void row(const char* name, const Counts& c) {
   std::printf("%-12s %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %10.3f %9.3f %9.3f\n", name, c.recall(),
               c.precision(), c.test_recall(), c.test_precision(),
@@ -251,6 +369,8 @@ int main(int argc, char** argv) {
       o.diagnose = int(value);
     else if (key == "repeats")
       o.repeats = int(value);
+    else if (key == "bookkeeping")
+      o.bookkeeping = int(value);
     else if (key == "pose_noise_mm")
       o.pose_noise_mm = value;
     else if (key == "pose_noise_deg")
@@ -361,11 +481,13 @@ int main(int argc, char** argv) {
     std::vector<double> ratios, search_ratios;
     Counts ca, ce;
     std::vector<std::uint8_t> flags_ant, flags_exhaustive;
+    std::vector<std::vector<int>> priorities;
     for (int repeat = 0; repeat < std::max(1, o.repeats); ++repeat) {
       flags_ant.clear();
       flags_exhaustive.clear();
-      ce = run(exhaustive, camera, frames, &flags_exhaustive);
-      ca = run(ant, camera, frames, &flags_ant);
+      priorities.clear();
+      run_both(ant, exhaustive, camera, frames, repeat % 2 == 0, ca, ce, flags_ant,
+               flags_exhaustive, priorities);
       ratios.push_back(median(ca.cpu_ms) / median(ce.cpu_ms));
       search_ratios.push_back(median(ca.search_cpu_ms) / median(ce.search_cpu_ms));
     }
@@ -381,6 +503,8 @@ int main(int argc, char** argv) {
         "time ratio ant/exhaustive (median of %d runs): module %.3f, search %.3f\n",
         double(kept) / std::max(1L, found), kept, found, std::max(1, o.repeats), median(ratios),
         median(search_ratios));
+    if (o.bookkeeping)
+      bookkeeping_report(base, camera, frames, flags_exhaustive, priorities, o.repeats);
   };
   if (o.sweeps.empty()) compare(params);
   for (const auto& [key, values] : o.sweeps) {

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pspslam/core/shared_paths.h"
+#include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/trajectory_io.h"
 #include "support/test_support.h"
 
@@ -205,6 +206,39 @@ TEST(CliRun, BonnCrowdDevSequenceReport) {
   EXPECT_TRUE(contains(r.output, "ground truth: yes (404 poses in groundtruth.txt)")) << r.output;
   // Whatever SLAM made of one frame, the trajectory file is a valid TUM file.
   EXPECT_NO_THROW(read_tum_trajectory(out / "trajectory.txt"));
+}
+
+// --export-map / --export-dense on a rendered room: the map PLY holds exactly the map points
+// the run reports, and the dense cloud, carried into the renderer's world with the first ground
+// truth pose (SLAM's world is the first camera), lies inside the 7 x 6 x 2.8 m room.
+TEST(CliRun, ExportsStaticMapAndDenseCloudAsPly) {
+  const auto dir = testing::make_temp_dir("cli_export");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 2 --seed 3");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                           (dir / "out").string() + " --dynamic geometry --export-map " +
+                           (dir / "map.ply").string() + " --export-dense " +
+                           (dir / "dense.ply").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::vector<ColoredPoint> map = read_point_cloud_ply(dir / "map.ply");
+  const std::vector<ColoredPoint> dense = read_point_cloud_ply(dir / "dense.ply");
+  EXPECT_TRUE(contains(r.output, " map points;")) << r.output;
+  EXPECT_TRUE(contains(r.output, ", " + std::to_string(map.size()) + " map points;")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(" + std::to_string(map.size()) + " points)")) << r.output;
+  EXPECT_GT(map.size(), 300u);
+  EXPECT_GT(dense.size(), 5000u);
+  const Trajectory truth = read_tum_trajectory(dir / "seq" / "groundtruth.txt");
+  ASSERT_FALSE(truth.empty());
+  const Pose T_room_slam = truth.front().T_world_camera;
+  size_t outside = 0;
+  for (const ColoredPoint& point : dense) {
+    const Eigen::Vector3d p = T_room_slam * point.position.cast<double>();
+    if (p.x() < -0.1 || p.y() < -0.1 || p.z() < -0.1 || p.x() > 7.1 || p.y() > 6.1 ||
+        p.z() > 2.9)
+      ++outside;
+  }
+  EXPECT_LT(outside, dense.size() / 200) << outside << " of " << dense.size();
 }
 
 }  // namespace

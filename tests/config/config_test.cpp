@@ -163,8 +163,7 @@ TEST(Config, InvalidValues) {
   const auto noise = write_file(dir, std::string(kValidCamera) + "  depth_noise: kinect\n");
   EXPECT_EQ(load_error(noise),
             noise.string() + ": key 'camera.depth_noise' must be none or kinect_v1, got 'kinect'");
-  const auto noise_scale =
-      write_file(dir, std::string(kValidCamera) + "  depth_noise_scale: 0\n");
+  const auto noise_scale = write_file(dir, std::string(kValidCamera) + "  depth_noise_scale: 0\n");
   EXPECT_EQ(load_error(noise_scale),
             noise_scale.string() + ": key 'camera.depth_noise_scale' must be > 0");
   const auto broken = write_file(dir, "camera: [1, 2\n");

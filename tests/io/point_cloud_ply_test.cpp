@@ -81,8 +81,7 @@ TEST(PointCloudPly, OtherFormatsAreRejectedWithTheReason) {
   const auto text = temp_file("not_ply.ply");
   std::ofstream(text) << "hello\n";
   EXPECT_NE(error_of(text).find("not a PLY file"), std::string::npos);
-  EXPECT_NE(error_of(temp_file("missing.ply")).find("cannot open point cloud"),
-            std::string::npos);
+  EXPECT_NE(error_of(temp_file("missing.ply")).find("cannot open point cloud"), std::string::npos);
 }
 
 }  // namespace

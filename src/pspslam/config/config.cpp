@@ -62,7 +62,8 @@ OrbConfig read_orb(YamlSection section) {
   orb.n_features = section.optional("n_features", orb.n_features);
   orb.scale_factor = section.optional("scale_factor", orb.scale_factor);
   orb.n_levels = section.optional("n_levels", orb.n_levels);
-  orb.initial_fast_threshold = section.optional("initial_fast_threshold", orb.initial_fast_threshold);
+  orb.initial_fast_threshold =
+      section.optional("initial_fast_threshold", orb.initial_fast_threshold);
   orb.min_fast_threshold = section.optional("min_fast_threshold", orb.min_fast_threshold);
   require_positive(orb.n_features, section, "n_features");
   if (!(orb.scale_factor > 1.0)) {

@@ -12,8 +12,8 @@ struct CameraConfig {
   std::string name = "unnamed";
   PinholeCamera pinhole;
   double fps = 30.0;
-  double depth_factor = 5000.0;   // depth image units per metre (5000 for TUM and Bonn)
-  double depth_threshold = 4.0;   // metres: closer points are "close" (reliable) points
+  double depth_factor = 5000.0;  // depth image units per metre (5000 for TUM and Bonn)
+  double depth_threshold = 4.0;  // metres: closer points are "close" (reliable) points
   // How a depth reading is weighed against the pixel in pose optimisation and bundle adjustment
   // (optional keys `depth_noise: none | kinect_v1`, `depth_noise_scale`). none: ORB-SLAM2's
   // virtual right coordinate, as firm as a pixel (robust to depth that is misregistered or out of

@@ -17,8 +17,8 @@ static_assert(std::endian::native == std::endian::little,
 constexpr std::size_t kVertexBytes = 3 * sizeof(float) + 3;
 
 constexpr std::array<const char*, 6> kVertexProperties = {
-    "property float x",      "property float y",     "property float z",
-    "property uchar red",    "property uchar green", "property uchar blue"};
+    "property float x",   "property float y",     "property float z",
+    "property uchar red", "property uchar green", "property uchar blue"};
 
 }  // namespace
 

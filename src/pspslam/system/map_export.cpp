@@ -80,8 +80,8 @@ std::vector<ColoredPoint> MapExporter::dense_cloud(const Map& map,
     for (size_t i = 0; i < pixels.size(); ++i) {
       const int x = static_cast<int>(pixels[i].x), y = static_cast<int>(pixels[i].y);
       const Eigen::Vector3d position =
-          T_world_camera * camera_.unproject({undistorted[i].x, undistorted[i].y},
-                                             image.depth.at<float>(y, x));
+          T_world_camera *
+          camera_.unproject({undistorted[i].x, undistorted[i].y}, image.depth.at<float>(y, x));
       if (options.voxel_size_m > 0.0 &&
           !occupied.insert(voxel_key(position, options.voxel_size_m)).second)
         continue;

@@ -155,10 +155,9 @@ bool OrbExtractor::is_ignored(const cv::Mat& ignore_mask, float level_x, float l
   // Tested on the level-0 mask at the keypoint's level-0 position rather than on a resized mask:
   // a down-sampled mask can lose thin masked strips, and this is the exact criterion the
   // returned keypoint has to meet anyway.
-  const int x = std::clamp(static_cast<int>(std::lround((level_x + 0.5f) * level.scale_x - 0.5f)),
-                           0, ignore_mask.cols - 1);
-  const int y = std::clamp(static_cast<int>(std::lround((level_y + 0.5f) * level.scale_y - 0.5f)),
-                           0, ignore_mask.rows - 1);
+  const cv::Point2f image = level.to_image(level_x, level_y);
+  const int x = std::clamp(static_cast<int>(std::lround(image.x)), 0, ignore_mask.cols - 1);
+  const int y = std::clamp(static_cast<int>(std::lround(image.y)), 0, ignore_mask.rows - 1);
   return ignore_mask.ptr<std::uint8_t>(y)[x] != 0;
 }
 
@@ -313,8 +312,7 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
     cv::KeyPoint& keypoint = out.keypoints[i];
     const PyramidLevel& level = pyramid_[keypoint.octave];
     describe(level.blurred, keypoint, out.descriptors.ptr<std::uint8_t>(i));
-    keypoint.pt.x = (keypoint.pt.x + 0.5f) * level.scale_x - 0.5f;
-    keypoint.pt.y = (keypoint.pt.y + 0.5f) * level.scale_y - 0.5f;
+    keypoint.pt = level.to_image(keypoint.pt.x, keypoint.pt.y);
   }
 }
 

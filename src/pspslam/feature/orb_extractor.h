@@ -71,6 +71,9 @@ class OrbExtractor {
     // scale factor: sizes are rounded). Plain x * scale would shift level-7 keypoints by ~1.3 px.
     float scale_x = 1.0f;
     float scale_y = 1.0f;
+    cv::Point2f to_image(float x, float y) const {
+      return {(x + 0.5f) * scale_x - 0.5f, (y + 0.5f) * scale_y - 0.5f};
+    }
   };
 
   void build_pyramid(const cv::Mat& gray);

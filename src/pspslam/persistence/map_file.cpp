@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iomanip>
 #include <iterator>
 #include <limits>
 #include <mutex>
@@ -15,6 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "pspslam/core/checksum.h"
 #include "pspslam/core/error.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
@@ -50,21 +50,6 @@ constexpr std::size_t kHeaderBytes = 32;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 constexpr std::size_t kKeypointBytes = 5 * 4 + 4 + 4 + 8;
 constexpr std::size_t kDescriptorBytes = 32;
-
-std::uint64_t fnv1a64(const char* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<std::uint8_t>(data[i]);
-    hash *= 0x100000001b3ULL;
-  }
-  return hash;
-}
-
-std::string hex64(std::uint64_t value) {
-  std::ostringstream out;
-  out << "0x" << std::hex << std::setw(16) << std::setfill('0') << value;
-  return out.str();
-}
 
 class Writer {
  public:

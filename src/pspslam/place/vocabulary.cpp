@@ -7,12 +7,11 @@
 #include <cstring>
 #include <deque>
 #include <fstream>
-#include <iomanip>
 #include <iterator>
 #include <limits>
 #include <random>
-#include <sstream>
 
+#include "pspslam/core/checksum.h"
 #include "pspslam/core/error.h"
 #include "pspslam/feature/hamming.h"
 
@@ -44,21 +43,6 @@ constexpr std::size_t kDescriptorBytes = kOrbDescriptorBytes;
 constexpr WordId kNoWord = std::numeric_limits<WordId>::max();
 constexpr int kMaxBranching = 255;  // child counts are stored in one byte
 constexpr int kMaxLevels = 10;
-
-std::uint64_t fnv1a64(const char* data, std::size_t size) {
-  std::uint64_t hash = 0xcbf29ce484222325ULL;
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<std::uint8_t>(data[i]);
-    hash *= 0x100000001b3ULL;
-  }
-  return hash;
-}
-
-std::string hex64(std::uint64_t value) {
-  std::ostringstream out;
-  out << "0x" << std::hex << std::setw(16) << std::setfill('0') << value;
-  return out.str();
-}
 
 template <typename T>
 T read_pod(const char* data) {

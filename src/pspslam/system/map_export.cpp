@@ -60,6 +60,7 @@ std::vector<ColoredPoint> MapExporter::dense_cloud(const Map& map,
   std::vector<ColoredPoint> cloud;
   std::unordered_set<std::uint64_t> occupied;
   std::vector<cv::Point2f> pixels;
+  std::vector<cv::Point2f> undistorted;
   for (const auto& keyframe : map.keyframes()) {
     if (keyframe->is_bad()) continue;
     const auto images = images_.find(keyframe->id());
@@ -75,7 +76,7 @@ std::vector<ColoredPoint> MapExporter::dense_cloud(const Map& map,
         pixels.emplace_back(static_cast<float>(x), static_cast<float>(y));
       }
     }
-    std::vector<cv::Point2f> undistorted = pixels;
+    undistorted.assign(pixels.begin(), pixels.end());
     camera_.undistort_points(undistorted);
     for (size_t i = 0; i < pixels.size(); ++i) {
       const int x = static_cast<int>(pixels[i].x), y = static_cast<int>(pixels[i].y);

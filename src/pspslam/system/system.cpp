@@ -473,7 +473,7 @@ FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Ma
   report.extraction_ms = milliseconds_since(start);
   const double cpu_tracking_start = thread_cpu_ms();
   report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
-  wait_for_local_mapping_if_synchronous(report);
+  wait_for_local_mapping_if_synchronous();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(frame));
   report.tracking_ms = milliseconds_since(tracking_start);
@@ -513,7 +513,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   report.extraction_ms += milliseconds_since(frame_start);
   report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
 
-  wait_for_local_mapping_if_synchronous(report);
+  wait_for_local_mapping_if_synchronous();
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
@@ -523,11 +523,8 @@ FrameReport System::process(const RgbdFrame& frame) {
   return report;
 }
 
-void System::wait_for_local_mapping_if_synchronous(FrameReport& report) {
-  if (!synchronous_local_mapping_) return;
-  const auto start = std::chrono::steady_clock::now();
-  mapping_->wait_until_idle();
-  report.mapping_wait_ms = milliseconds_since(start);
+void System::wait_for_local_mapping_if_synchronous() {
+  if (synchronous_local_mapping_) mapping_->wait_until_idle();
 }
 
 cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }

@@ -101,7 +101,6 @@ struct FrameReport {
   TrackResult tracking;
   double extraction_ms = 0.0;
   double tracking_ms = 0.0;
-  double mapping_wait_ms = 0.0;  // synchronous_local_mapping: waited for local mapping
   // CPU time of the calling thread: on a shared, loaded machine wall time includes waiting
   // for a core, CPU time does not.
   double extraction_cpu_ms = 0.0;
@@ -182,7 +181,7 @@ class System {
   class MappingConnection;
   class DynamicPipeline;
 
-  void wait_for_local_mapping_if_synchronous(FrameReport& report);
+  void wait_for_local_mapping_if_synchronous();
 
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;

@@ -9,6 +9,7 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/solve/pnp_ransac.h"
+#include "pspslam/tracking/frame_pose_optimization.h"
 
 namespace pspslam {
 namespace {
@@ -132,25 +133,10 @@ bool Relocalizer::try_candidate(Frame& frame, const std::shared_ptr<KeyFrame>& k
 }
 
 int Relocalizer::optimize_and_prune(Frame& frame) {
-  observations_.clear();
-  observation_keypoint_.clear();
-  const ScalePyramid& pyramid = frame.pyramid();
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& point = frame.map_points[i];
-    if (!point) continue;
-    const cv::KeyPoint& kp = frame.keypoints()[i];
-    observations_.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                             static_cast<double>(frame.right_u(i)), pyramid.inv_sigma2[kp.octave]});
-    observation_keypoint_.push_back(i);
-  }
   const PoseOptimizationResult optimized =
-      optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
-                    observations_, options_.pose_optimizer);
-  Pose pose = optimized.T_camera_world;
-  pose.linear() = Eigen::Quaterniond(pose.rotation()).normalized().toRotationMatrix();
-  frame.set_pose(pose);
-  for (size_t k = 0; k < observation_keypoint_.size(); ++k) {
-    if (!optimized.inlier[k]) frame.map_points[observation_keypoint_[k]] = nullptr;
+      optimize_frame_pose(frame, options_.pose_optimizer, pose_buffers_);
+  for (size_t k = 0; k < pose_buffers_.keypoint_of_observation.size(); ++k) {
+    if (!optimized.inlier[k]) frame.map_points[pose_buffers_.keypoint_of_observation[k]] = nullptr;
   }
   std::fill(frame.outlier.begin(), frame.outlier.end(), 0);
   return count_matches(frame);

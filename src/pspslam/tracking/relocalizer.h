@@ -8,6 +8,7 @@
 #include "pspslam/match/orb_matcher.h"
 #include "pspslam/optimize/pose_optimizer.h"
 #include "pspslam/place/bow_matching.h"
+#include "pspslam/tracking/frame_pose_optimization.h"
 
 namespace pspslam {
 
@@ -76,8 +77,7 @@ class Relocalizer {
   std::vector<Eigen::Vector3d> points_world_;  // PnP correspondences
   std::vector<Eigen::Vector2d> pixels_;
   std::vector<int> keypoint_;
-  std::vector<PoseObservation> observations_;
-  std::vector<int> observation_keypoint_;
+  FramePoseBuffers pose_buffers_;
   std::vector<ProjectedPoint> projected_;
 };
 

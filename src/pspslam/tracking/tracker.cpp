@@ -7,23 +7,11 @@
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
 #include "pspslam/solve/pnp_ransac.h"
+#include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
-namespace {
-
-// Re-projects the rotation onto SO(3). The constant-velocity prediction multiplies a pose by
-// the inverse of another (Isometry inverse = transpose): rounding errors in the rotation grow
-// by a factor ~2 per frame through that loop unless they are removed.
-Pose orthonormalized(const Pose& pose) {
-  Pose out = pose;
-  out.linear() = Eigen::Quaterniond(pose.rotation()).normalized().toRotationMatrix();
-  return out;
-}
-
-}  // namespace
-
 const char* to_string(TrackingState state) {
   switch (state) {
     case TrackingState::kNotInitialized:
@@ -199,23 +187,10 @@ int Tracker::discard_outliers(Frame& frame) {
 }
 
 int Tracker::optimize_frame_pose(Frame& frame) {
-  observations_.clear();
-  observation_keypoint_.clear();
-  const ScalePyramid& pyramid = frame.pyramid();
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& point = frame.map_points[i];
-    if (!point) continue;
-    const cv::KeyPoint& kp = frame.keypoints()[i];
-    observations_.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                             static_cast<double>(frame.right_u(i)), pyramid.inv_sigma2[kp.octave]});
-    observation_keypoint_.push_back(i);
-  }
   const PoseOptimizationResult optimized =
-      optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
-                    observations_, options_.pose_optimizer);
-  frame.set_pose(orthonormalized(optimized.T_camera_world));
-  for (size_t k = 0; k < observation_keypoint_.size(); ++k) {
-    frame.outlier[observation_keypoint_[k]] = optimized.inlier[k] ? 0 : 1;
+      pspslam::optimize_frame_pose(frame, options_.pose_optimizer, pose_buffers_);
+  for (size_t k = 0; k < pose_buffers_.keypoint_of_observation.size(); ++k) {
+    frame.outlier[pose_buffers_.keypoint_of_observation[k]] = optimized.inlier[k] ? 0 : 1;
   }
   return optimized.num_inliers;
 }

@@ -9,6 +9,7 @@
 #include "pspslam/map/frame.h"
 #include "pspslam/match/orb_matcher.h"
 #include "pspslam/optimize/pose_optimizer.h"
+#include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_policy.h"
 #include "pspslam/tracking/local_map.h"
 #include "pspslam/tracking/relocalizer.h"
@@ -146,8 +147,7 @@ class Tracker {
   std::vector<FrameAnchor> anchors_;
 
   // Reused per-frame buffers (no allocation per keypoint).
-  std::vector<PoseObservation> observations_;
-  std::vector<int> observation_keypoint_;
+  FramePoseBuffers pose_buffers_;
   std::vector<ProjectedPoint> projected_;
 };
 

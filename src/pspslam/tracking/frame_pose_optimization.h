@@ -1,0 +1,30 @@
+#pragma once
+
+#include <vector>
+
+#include "pspslam/core/types.h"
+#include "pspslam/optimize/pose_optimizer.h"
+
+namespace pspslam {
+
+class Frame;
+
+// Re-projects the rotation onto SO(3). The constant-velocity prediction multiplies a pose by
+// the inverse of another (Isometry inverse = transpose): rounding errors in the rotation grow
+// by a factor ~2 per frame through that loop unless they are removed.
+Pose orthonormalized(const Pose& pose);
+
+// Buffers reused from frame to frame (no allocation per keypoint once they have grown).
+struct FramePoseBuffers {
+  std::vector<PoseObservation> observations;
+  std::vector<int> keypoint_of_observation;  // frame keypoint index of observations[k]
+};
+
+// Pose-only optimisation of `frame` on its current map point matches (every keypoint with a map
+// point, from the frame's pose as the initial guess); sets the optimised, orthonormalised pose
+// on the frame. result.inlier[k] is the verdict on keypoint buffers.keypoint_of_observation[k];
+// what to do with outliers is the caller's choice (tracking flags them, relocalisation drops them).
+PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
+                                           FramePoseBuffers& buffers);
+
+}  // namespace pspslam

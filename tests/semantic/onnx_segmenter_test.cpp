@@ -36,6 +36,66 @@ double person_iou(Segmenter& segmenter, const std::filesystem::path& shared, int
   return uni == 0 ? 1.0 : inter / uni;
 }
 
+// Checks the vectorised pre- and post-processing against plain loops, bit for bit: the blob is
+// (pixel - mean) / std per network channel, the labels are the first arg-max of the logits.
+// `image` has the network's input size (no resizing in between).
+void expect_exact_blob_and_argmax(OnnxSegmenter& segmenter, const cv::Mat& image) {
+  const SegmenterMetadata& meta = segmenter.metadata();
+  ASSERT_EQ(image.size(), cv::Size(meta.input_width, meta.input_height));
+  const LabelMap labels = segmenter.segment(image);
+  const cv::Mat& blob = segmenter.last_input();
+  int blob_mismatches = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int channel = meta.rgb ? 2 - k : k;
+    const auto mean = static_cast<float>(meta.mean[static_cast<size_t>(k)]);
+    const auto stdev = static_cast<float>(meta.std[static_cast<size_t>(k)]);
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const int idx[4] = {0, k, y, x};
+        const float expected =
+            (static_cast<float>(image.at<cv::Vec3b>(y, x)[channel]) - mean) / stdev;
+        blob_mismatches += blob.at<float>(idx) != expected;
+      }
+    }
+  }
+  EXPECT_EQ(blob_mismatches, 0);
+
+  const cv::Mat& logits = segmenter.logits(image);
+  int label_mismatches = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      int best = 0;
+      for (int c = 1; c < logits.size[1]; ++c) {
+        const int candidate[4] = {0, c, y, x};
+        const int current[4] = {0, best, y, x};
+        if (logits.at<float>(candidate) > logits.at<float>(current)) best = c;
+      }
+      label_mismatches += labels.at<uchar>(y, x) != best;
+    }
+  }
+  EXPECT_EQ(label_mismatches, 0);
+}
+
+TEST(OnnxSegmenter, BlobAndArgMaxEqualPlainLoops) {
+  OnnxSegmenter segmenter(load_segmenter_metadata(kModelDir / "pspnet.yaml"));
+  const cv::Mat input = cv::imread((kModelDir / "golden" / "input.png").string());
+  ASSERT_FALSE(input.empty());
+  expect_exact_blob_and_argmax(segmenter, input);
+}
+
+TEST(OnnxSegmenter, BlobAndArgMaxEqualPlainLoopsOnRowsThatAreNotMultiplesOf16) {
+  PSPSLAM_SHARED_OR_SKIP(shared);
+  // DeepLab's 513x513 input exercises the scalar tails of the 16-pixel loops.
+  OnnxSegmenter teacher(
+      load_segmenter_metadata(source_dir() / "models" / "teachers" / "deeplabv3_mnv2_pascal.yaml"));
+  const int id = validation_ids().front();
+  cv::Mat photo = cv::imread(
+      (shared / "data" / "human_seg" / "images" / (std::to_string(id) + ".jpg")).string());
+  ASSERT_FALSE(photo.empty());
+  cv::resize(photo, photo, cv::Size(513, 513), 0, 0, cv::INTER_LINEAR);
+  expect_exact_blob_and_argmax(teacher, photo);
+}
+
 TEST(OnnxSegmenter, MatchesTheLogitsRecordedAtExport) {
   OnnxSegmenter segmenter(load_segmenter_metadata(kModelDir / "pspnet.yaml"));
   const cv::Mat input = cv::imread((kModelDir / "golden" / "input.png").string());

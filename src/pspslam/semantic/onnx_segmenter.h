@@ -41,7 +41,6 @@ class OnnxSegmenter : public Segmenter {
   cv::Mat blob_;
   cv::Mat logits_;
   cv::Mat labels_small_;
-  cv::Mat best_;
 };
 
 }  // namespace pspslam

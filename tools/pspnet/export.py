@@ -2,6 +2,7 @@
 
 * fixed input size (the pyramid pooling bins become fixed-kernel average pooling);
 * Identity nodes on initialisers replaced by initialiser copies (OpenCV 4.6 rejects them);
+* Pad nodes with all-zero pads removed (each costs OpenCV a copy);
 * loads the file with cv2.dnn and fails (exit 1) when any logit differs from PyTorch by
   more than --tolerance on the golden input and on validation photos;
 * writes the metadata YAML read by the C++ OnnxSegmenter and, with --golden, a small
@@ -19,7 +20,7 @@ import torch
 
 import common
 from model import PSPNet
-from onnx_fix import replace_identity_on_initializers
+from onnx_fix import remove_zero_pads, replace_identity_on_initializers
 
 
 def golden_image(width, height, seed=7):
@@ -117,10 +118,12 @@ def main():
                       output_names=["logits"], do_constant_folding=True)
     graph = onnx.load(str(onnx_path))
     replaced = replace_identity_on_initializers(graph)
+    pads = remove_zero_pads(graph)
     onnx.checker.check_model(graph)
     onnx.save(graph, str(onnx_path))
     size_mb = onnx_path.stat().st_size / 2**20
-    print(f"wrote {onnx_path} ({size_mb:.2f} MiB, {replaced} Identity nodes replaced)")
+    print(f"wrote {onnx_path} ({size_mb:.2f} MiB, {replaced} Identity nodes replaced, "
+          f"{pads} zero Pad nodes removed)")
 
     net = cv2.dnn.readNetFromONNX(str(onnx_path))
     inputs = [("golden", golden_image(args.width, args.height))]

@@ -26,3 +26,30 @@ def replace_identity_on_initializers(model):
     del graph.input[:]
     graph.input.extend(inputs)
     return replaced
+
+
+def remove_zero_pads(model):
+    """Removes constant Pad nodes whose pads are all zero (torch emits one before each
+    AveragePool of the pyramid pooling): OpenCV 4.6 runs each as a copy of the 160-channel
+    map.  Their consumers read the Pad's input instead.  Returns the count."""
+    graph = model.graph
+    rename, keep = {}, []
+    for node in graph.node:
+        attrs = {a.name: onnx.helper.get_attribute_value(a) for a in node.attribute}
+        if (node.op_type == "Pad" and len(node.input) == 1
+                and attrs.get("mode", b"constant") == b"constant"
+                and not any(attrs.get("pads", [1]))):
+            rename[node.output[0]] = node.input[0]
+        else:
+            keep.append(node)
+    outputs = {o.name for o in graph.output}
+    if outputs & rename.keys():
+        raise ValueError("a zero Pad produces a graph output")
+    for node in keep:
+        for i, name in enumerate(node.input):
+            while name in rename:
+                name = rename[name]
+            node.input[i] = name
+    del graph.node[:]
+    graph.node.extend(keep)
+    return len(rename)

@@ -1,7 +1,7 @@
 // Segmentation accuracy and speed through the C++ path (OpenCV DNN, CPU).
 //
 //   bench_segmentation [--models a.yaml,b.yaml] [--threads 2] [--frames 20] [--no-iou]
-//                      [google-benchmark flags]
+//                      [--profile] [google-benchmark flags]
 //
 // 1. Prints the person IoU (mean over the human_seg validation split of
 //    models/pspnet/human_seg_split.json, masks resized to the photo) of each model.
@@ -9,6 +9,9 @@
 //    cv::setNumThreads(threads); the counter median_ms is the median wall time over --frames
 //    frames, cpu_ms the median CPU time of the whole process (all OpenCV threads) per frame.
 //    On the shared, loaded machine wall time includes waiting for a core; CPU time does not.
+// 3. With --profile, first prints per model the median wall time of the stages of segment()
+//    (pre-processing, network, post-processing) and of the network's layers summed by type
+//    (cv::dnn::Net::getPerfProfile), over the same frames.
 // Needs ../shared (PSPSLAM_SHARED); defaults to our PSPNet at its three exported sizes and the
 // three teachers.
 #include <benchmark/benchmark.h>
@@ -24,6 +27,7 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -42,6 +46,7 @@ struct Options {
   int threads = 2;
   int frames = 20;
   bool iou = true;
+  bool profile = false;
 };
 
 double median(std::vector<double> v) {
@@ -85,6 +90,40 @@ std::vector<cv::Mat> bonn_frames(const fs::path& shared, int count) {
   return frames;
 }
 
+// Median stage and per-layer-type times of segment() over `frames` (after one warm-up call).
+void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames) {
+  segmenter.segment(frames.front());
+  cv::dnn::Net& net = segmenter.network();
+  const std::vector<std::string> names = net.getLayerNames();
+  std::vector<std::string> layer_types;
+  for (const std::string& name : names) layer_types.push_back(net.getLayer(name)->type);
+  std::vector<double> pre, network, post;
+  std::map<std::string, std::vector<double>> by_type;
+  std::vector<double> layer_ticks;
+  for (const cv::Mat& frame : frames) {
+    segmenter.segment(frame);
+    const auto& stages = segmenter.last_stage_times();
+    pre.push_back(stages.preprocess_ms);
+    network.push_back(stages.network_ms);
+    post.push_back(stages.postprocess_ms);
+    net.getPerfProfile(layer_ticks);  // indexed like getLayerNames()
+    std::map<std::string, double> sums;
+    for (size_t i = 0; i < layer_ticks.size() && i < layer_types.size(); ++i) {
+      sums[layer_types[i]] += 1000.0 * layer_ticks[i] / cv::getTickFrequency();
+    }
+    for (const auto& [type, ms] : sums) by_type[type].push_back(ms);
+  }
+  const auto& meta = segmenter.metadata();
+  std::printf(
+      "%s %dx%d, median over %zu frames: pre-processing %.2f ms, network %.2f ms, "
+      "post-processing %.2f ms\n  network layers by type (ms):",
+      meta.name.c_str(), meta.input_width, meta.input_height, frames.size(), median(pre),
+      median(network), median(post));
+  for (const auto& [type, ms] : by_type) std::printf(" %s %.2f", type.c_str(), median(ms));
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
 Options parse(int* argc, char** argv) {
   Options o;
   std::vector<char*> rest = {argv[0]};
@@ -103,6 +142,8 @@ Options parse(int* argc, char** argv) {
       o.frames = std::stoi(value());
     } else if (a == "--no-iou") {
       o.iou = false;
+    } else if (a == "--profile") {
+      o.profile = true;
     } else {
       rest.push_back(argv[i]);
     }
@@ -144,6 +185,9 @@ int main(int argc, char** argv) {
                     meta.input_height, iou, count);
         std::fflush(stdout);
       }
+    }
+    if (options.profile) {
+      for (const fs::path& m : options.models) print_profile(*OnnxSegmenter::from_file(m), frames);
     }
     for (const fs::path& m : options.models) {
       auto meta = pspslam::load_segmenter_metadata(m);

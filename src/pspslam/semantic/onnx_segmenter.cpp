@@ -138,9 +138,13 @@ void OnnxSegmenter::make_blob(const cv::Mat& bgr) {
 }
 
 const cv::Mat& OnnxSegmenter::logits(const cv::Mat& bgr) {
+  const Clock::time_point start = Clock::now();
   make_blob(bgr);
+  stage_times_.preprocess_ms = elapsed_ms(start);
+  const Clock::time_point network_start = Clock::now();
   net_.setInput(blob_);
   logits_ = net_.forward();
+  stage_times_.network_ms = elapsed_ms(network_start);
   const int classes = static_cast<int>(meta_.classes.size());
   const int h = meta_.input_height / meta_.output_stride;
   const int w = meta_.input_width / meta_.output_stride;
@@ -160,6 +164,7 @@ const cv::Mat& OnnxSegmenter::logits(const cv::Mat& bgr) {
 
 LabelMap OnnxSegmenter::segment(const cv::Mat& bgr) {
   const cv::Mat& out = logits(bgr);
+  const Clock::time_point start = Clock::now();
   const int classes = out.size[1];
   const int h = out.size[2];
   const int w = out.size[3];
@@ -172,6 +177,7 @@ LabelMap OnnxSegmenter::segment(const cv::Mat& bgr) {
   } else {
     cv::resize(labels_small_, labels, bgr.size(), 0, 0, cv::INTER_NEAREST);
   }
+  stage_times_.postprocess_ms = elapsed_ms(start);
   return labels;
 }
 

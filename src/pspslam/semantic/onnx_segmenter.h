@@ -2,6 +2,7 @@
 
 #include <opencv2/dnn.hpp>
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
@@ -32,7 +33,21 @@ class OnnxSegmenter : public Segmenter {
 
   const SegmenterMetadata& metadata() const { return meta_; }
 
+  // Wall time of the stages of the last segment() call (profiling; two clock reads per stage).
+  struct StageTimes {
+    double preprocess_ms = 0;   // resize + normalisation into the blob
+    double network_ms = 0;      // setInput + forward
+    double postprocess_ms = 0;  // arg-max + label resize to the image
+  };
+  const StageTimes& last_stage_times() const { return stage_times_; }
+  // The network, for cv::dnn::Net::getPerfProfile (per-layer times of the last forward).
+  cv::dnn::Net& network() { return net_; }
+
  private:
+  using Clock = std::chrono::steady_clock;
+  static double elapsed_ms(Clock::time_point since) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+  }
   void make_blob(const cv::Mat& bgr);
 
   SegmenterMetadata meta_;
@@ -41,6 +56,7 @@ class OnnxSegmenter : public Segmenter {
   cv::Mat blob_;
   cv::Mat logits_;
   cv::Mat labels_small_;
+  StageTimes stage_times_;
 };
 
 }  // namespace pspslam

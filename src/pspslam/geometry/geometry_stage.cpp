@@ -11,6 +11,9 @@
 namespace pspslam {
 namespace {
 
+// Marks a candidate whose depth has not been read yet (depths are >= 0).
+constexpr double kDepthNotRead = -1.0;
+
 // Wall and thread-CPU clocks read together, so each stage part reports both.
 struct Stopwatch {
   std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
@@ -101,25 +104,35 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   result.timing.homography_ms = start.wall_ms();
   result.timing.homography_cpu_ms = start.cpu_ms();
 
-  // Candidates with their depths.
+  // Candidates. Work per point that only a tested point needs (its depth: a read at a random
+  // place of the depth image when the caller gives none) is done lazily in depth_of(), so the
+  // ant colony pays it only for the points it tests; the exhaustive baseline pays it for all.
   const size_t n = input.keypoints.size();
   points_.resize(n);
   candidates_.resize(n);
   priority_.clear();
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& pixel = input.keypoints[i];
-    points_[i] = pixel.cast<float>();
-    double depth = 0.0;
+  const auto depth_of = [&](size_t i) {
+    double& depth = candidates_[i].depth;
+    if (depth != kDepthNotRead) return depth;
+    depth = 0.0;
     if (!input.keypoint_depths.empty()) {
       depth = input.keypoint_depths[i];
     } else {
-      const int u = static_cast<int>(std::lround(pixel.x()));
-      const int v = static_cast<int>(std::lround(pixel.y()));
+      const int u = static_cast<int>(std::lround(candidates_[i].pixel.x()));
+      const int v = static_cast<int>(std::lround(candidates_[i].pixel.y()));
       if (u >= 0 && v >= 0 && u < input.depth.cols && v < input.depth.rows)
-        depth = input.depth.at<float>(v, u);
+        depth = input.depth.ptr<float>(v)[u];
     }
-    candidates_[i] = {pixel, depth};
-    if (params_.previous_mask_prior && have_previous_mask) {
+    return depth;
+  };
+  // Only the ant colony uses the priority points (the exhaustive baseline tests every point).
+  const bool use_prior = params_.previous_mask_prior && have_previous_mask &&
+                         params_.search.strategy == SearchStrategy::ant_colony;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& pixel = input.keypoints[i];
+    points_[i] = pixel.cast<float>();
+    candidates_[i] = {pixel, kDepthNotRead};
+    if (use_prior) {
       // Where was this pixel in the previous frame? (inverse of the compensating homography)
       const Eigen::Vector2d previous_pixel = transfer_point(current_to_previous, pixel);
       const int u = static_cast<int>(std::floor(previous_pixel.x()));
@@ -134,6 +147,9 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   const Stopwatch selection_start;
   std::span<const DepthView> references = input.references;
   if (references.size() > static_cast<size_t>(params_.multiview.max_reference_views)) {
+    // The selector estimates coverage on every point_stride-th candidate: only those need depths.
+    for (size_t i = 0; i < n; i += static_cast<size_t>(params_.references.point_stride))
+      depth_of(i);
     selected_references_.clear();
     for (int v : selector_.select(input.T_world_camera, candidates_, input.references))
       selected_references_.push_back(input.references[v]);
@@ -148,7 +164,11 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   test_.set_frame(input.T_world_camera, references);
   const SearchResult& search = search_.run(
       points_, input.depth.size(),
-      [this](int index) { return test_.is_dynamic(candidates_[index]); }, priority_);
+      [&](int index) {
+        depth_of(static_cast<size_t>(index));
+        return test_.is_dynamic(candidates_[index]);
+      },
+      priority_);
   result.timing.search_ms = search_start.wall_ms();
   result.timing.search_cpu_ms = search_start.cpu_ms();
 
@@ -160,7 +180,7 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   for (size_t i = 0; i < n; ++i) {
     if (search.dynamic[i]) {
       seeds_.push_back(points_[i]);
-      seed_depths_.push_back(static_cast<float>(candidates_[i].depth));
+      seed_depths_.push_back(static_cast<float>(depth_of(i)));
     } else if (search.tested[i]) {
       static_points_.push_back(points_[i]);
     }

@@ -100,25 +100,32 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
     if (cos_parallax < cos_max_parallax_) continue;
     const double threshold =
         params_.depth_threshold_abs_m + params_.depth_threshold_relative * projected_depth;
+    // A pixel of the patch agrees when it is valid (> 0) and within [lower, upper]; farther_only
+    // accepts anything closer than projected + threshold. Float bounds: 1e-7 relative, far below
+    // the sensor's 0.2 mm depth quantisation.
+    const float upper = static_cast<float>(projected_depth + threshold);
+    const float lower = params_.disagreement == DepthDisagreement::farther_only
+                            ? 0.0f
+                            : static_cast<float>(projected_depth - threshold);
     // The reference agrees when any valid pixel of the patch is consistent with the point. The
-    // centre is checked first: for the many static points it settles the question at once.
-    int valid_pixels = 0;
-    bool consistent = false;
-    const auto check = [&](float measured) {
-      if (!(measured > 0.0f)) return;
-      ++valid_pixels;
-      const double difference = measured - projected_depth;
-      const bool disagrees = params_.disagreement == DepthDisagreement::farther_only
-                                 ? difference > threshold
-                                 : std::abs(difference) > threshold;
-      if (!disagrees) consistent = true;
-    };
-    check(ref.depth.ptr<float>(v)[u]);
-    for (int dv = -r; dv <= r && !consistent; ++dv) {
-      const float* row = ref.depth.ptr<float>(v + dv);
-      for (int du = -r; du <= r && !consistent; ++du) {
-        if (du != 0 || dv != 0) check(row[u + du]);
+    // centre settles it for most static points (one read). Otherwise the whole patch is scanned
+    // without a data-dependent branch: its 2r+1 rows lie in different cache lines, and a
+    // branch-free scan issues their loads together instead of one after another (a dynamic point
+    // must read every pixel anyway: "every valid pixel disagrees").
+    const float centre = ref.depth.ptr<float>(v)[u];
+    bool consistent = centre > 0.0f && centre >= lower && centre <= upper;
+    int valid_pixels = centre > 0.0f;
+    if (!consistent) {
+      int agree = 0;
+      for (int dv = -r; dv <= r; ++dv) {
+        const float* row = ref.depth.ptr<float>(v + dv) + (u - r);
+        for (int k = 0; k <= 2 * r; ++k) {
+          const float measured = row[k];
+          valid_pixels |= measured > 0.0f;
+          agree |= (measured > 0.0f) & (measured >= lower) & (measured <= upper);
+        }
       }
+      consistent = agree != 0;
     }
     if (valid_pixels == 0) continue;
     ++verdict.valid_references;

@@ -64,11 +64,13 @@ class DynamicRegionGrower {
  private:
   RegionGrowParams params_;
   float focal_length_px_ = 0.0f;
-  cv::Mat grid_depth_;             // CV_32F, one sample per block
+  cv::Mat grid_depth_;             // CV_32F, one sample per block, read on first use
   std::vector<int> region_of_;     // -1 = not visited; otherwise seed region id
   std::vector<int> region_seeds_;  // dynamic seeds that fell inside each region
   std::vector<std::uint8_t> barrier_;
   std::vector<int> queue_;
+  std::vector<float> fill_sample_;  // per pixel column: its block's sample (NaN: not grown)
+  std::vector<float> fill_step_;    // per pixel column: its block's continuity step
 };
 
 }  // namespace pspslam

@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
   };
 
   // (1) Compensated homography on consecutive pairs.
-  std::vector<double> improvement, relative, before_all, after_all, h_cpu;
+  std::vector<double> improvement, relative, before_all, after_all, h_cpu, lm_iterations;
   int lower = 0, pairs = 0;
   for (size_t i = 1; i < frames.size(); ++i) {
     const std::vector<cv::DMatch> m = match(frames[i - 1], frames[i]);
@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
     if (!h.valid) continue;
     ++pairs;
     h_cpu.push_back((t1.tv_sec - t0.tv_sec) * 1e3 + (t1.tv_nsec - t0.tv_nsec) * 1e-6);
+    lm_iterations.push_back(h.lm_iterations);
     lower += h.rms_after_px < h.rms_before_px;
     improvement.push_back(h.rms_before_px - h.rms_after_px);
     relative.push_back((h.rms_before_px - h.rms_after_px) / h.rms_before_px);
@@ -201,7 +202,8 @@ int main(int argc, char** argv) {
               median(improvement), percentile(improvement, 0.95));
   std::printf("  improvement (rel) p5 %.4f  median %.4f  p95 %.4f\n", percentile(relative, 0.05),
               median(relative), percentile(relative, 0.95));
-  std::printf("  cpu per pair median %.3f ms\n", median(h_cpu));
+  std::printf("  cpu per pair median %.3f ms; LM iterations median %.0f, p95 %.0f\n", median(h_cpu),
+              median(lm_iterations), percentile(lm_iterations, 0.95));
 
   // (2) Stage cost, ant colony vs exhaustive, same frames, same process.
   // Inputs first (references, matches to the previous frame), so that the timed passes below
@@ -274,6 +276,28 @@ int main(int argc, char** argv) {
   std::vector<double> ant_cpu, ex_cpu, ant_wall, ex_wall, ant_search, ex_search, tested_share;
   std::vector<double> ant_no_h, ex_no_h, selection, ant_region, ex_region;
   std::vector<double> pass_module_ratio, pass_search_ratio, pass_no_h_ratio;
+  // The per-frame times are bimodal (static room frames: few dynamic points; crowd frames: half
+  // the points on people), so a median can sit between the modes and jump between passes. The
+  // ratio of totals (time over all frames) and the medians within each part are reported too.
+  std::vector<double> pass_search_total_ratio, pass_no_h_total_ratio, pass_crowd_search_ratio,
+      pass_static_search_ratio, pass_crowd_no_h_ratio;
+  const auto sum = [](const std::vector<double>& v) {
+    double total = 0.0;
+    for (double x : v) total += x;
+    return total;
+  };
+  const auto part_ratio = [&](const std::vector<double>& ant_v, const std::vector<double>& ex_v,
+                              bool crowd) {
+    std::vector<double> a, e;
+    for (size_t k = 0; k < stage_frames.size(); ++k) {
+      const int index = frame_index[stage_frames[k].index];
+      if (crowd ? index >= 220 : index < 215) {
+        a.push_back(ant_v[k]);
+        e.push_back(ex_v[k]);
+      }
+    }
+    return median(a) / median(e);
+  };
   long static_flags = 0, static_points = 0, crowd_flags = 0, crowd_points = 0, kept = 0, found = 0;
   for (int pass = 0; pass < std::max(1, repeats); ++pass) {
     GeometryStage ant(ideal, ant_params), exhaustive(ideal, exhaustive_params);
@@ -332,12 +356,29 @@ int main(int argc, char** argv) {
     pass_module_ratio.push_back(median(ant_cpu) / median(ex_cpu));
     pass_search_ratio.push_back(median(ant_search) / median(ex_search));
     pass_no_h_ratio.push_back(median(ant_no_h) / median(ex_no_h));
+    pass_search_total_ratio.push_back(sum(ant_search) / sum(ex_search));
+    pass_no_h_total_ratio.push_back(sum(ant_no_h) / sum(ex_no_h));
+    pass_crowd_search_ratio.push_back(part_ratio(ant_search, ex_search, true));
+    pass_static_search_ratio.push_back(part_ratio(ant_search, ex_search, false));
+    pass_crowd_no_h_ratio.push_back(part_ratio(ant_no_h, ex_no_h, true));
+    std::printf(
+        "  pass %d: totals over frames: search %.3f, without H %.3f; medians over crowd frames "
+        ">=220: search %.3f, without H %.3f; static frames <215: search %.3f\n",
+        pass, pass_search_total_ratio.back(), pass_no_h_total_ratio.back(),
+        pass_crowd_search_ratio.back(), pass_crowd_no_h_ratio.back(),
+        pass_static_search_ratio.back());
     std::printf("  pass %d: ratio ant/exhaustive module %.3f, search %.3f, without H %.3f\n", pass,
                 pass_module_ratio.back(), pass_search_ratio.back(), pass_no_h_ratio.back());
   }
   std::printf("  median over %d passes: ratio module %.3f, search %.3f, without H %.3f\n",
               std::max(1, repeats), median(pass_module_ratio), median(pass_search_ratio),
               median(pass_no_h_ratio));
+  std::printf(
+      "  median over %d passes: totals search %.3f, without H %.3f; crowd frames search %.3f, "
+      "without H %.3f; static frames search %.3f\n",
+      std::max(1, repeats), median(pass_search_total_ratio), median(pass_no_h_total_ratio),
+      median(pass_crowd_search_ratio), median(pass_crowd_no_h_ratio),
+      median(pass_static_search_ratio));
   if (poses.empty())
     std::printf("\ngeometry stage over %zu frames (5 PnP references each, 10 frames apart):\n",
                 ant_cpu.size());

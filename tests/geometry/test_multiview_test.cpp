@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
 #include "pspslam/geometry/multiview_test.h"
@@ -107,6 +109,71 @@ TEST(MultiViewTest, VoteFraction) {
   EXPECT_TRUE(first.dynamic);
   EXPECT_EQ(first.dynamic_votes, 1);
   EXPECT_EQ(first.valid_references, 1);
+}
+
+// The patch rule written out pixel by pixel in double precision: a reference votes dynamic when
+// the patch has a valid pixel and every valid pixel disagrees.
+bool patch_votes_dynamic(const cv::Mat& depth, int u, int v, int r, double projected,
+                         const MultiViewParams& p) {
+  const double threshold = p.depth_threshold_abs_m + p.depth_threshold_relative * projected;
+  bool valid = false, agrees = false;
+  for (int y = v - r; y <= v + r; ++y) {
+    for (int x = u - r; x <= u + r; ++x) {
+      const double measured = depth.at<float>(y, x);
+      if (!(measured > 0.0)) continue;
+      valid = true;
+      const double difference = measured - projected;
+      agrees |= p.disagreement == DepthDisagreement::farther_only
+                    ? difference <= threshold
+                    : std::abs(difference) <= threshold;
+    }
+  }
+  return valid && !agrees;
+}
+
+// The cached block bounds, the centre shortcut and the branch-free scan must give the verdict of
+// the plain rule on every point: a depth image of random boxes (edges everywhere) with 10 %
+// holes, points near the measured depths, both disagreement rules, the cache reused over frames.
+TEST(MultiViewTest, ShortcutsMatchThePlainPatchRule) {
+  std::mt19937 rng(11);
+  cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.5f));
+  std::uniform_int_distribution<int> x_of(0, 639), y_of(0, 479), size_of(4, 60);
+  std::uniform_real_distribution<float> depth_of(0.8f, 4.0f), unit(0.0f, 1.0f);
+  for (int box = 0; box < 400; ++box) {
+    const int x = x_of(rng), y = y_of(rng);
+    const cv::Rect rect = cv::Rect(x, y, size_of(rng), size_of(rng)) & cv::Rect(0, 0, 640, 480);
+    depth(rect).setTo(depth_of(rng));
+  }
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x)
+      if (unit(rng) < 0.1f) depth.at<float>(y, x) = 0.0f;
+  const std::vector<DepthView> references{{Pose::Identity(), depth}};
+  std::uniform_real_distribution<double> offset(-0.4, 0.4);
+  for (const DepthDisagreement rule :
+       {DepthDisagreement::farther_only, DepthDisagreement::either_sign}) {
+    MultiViewParams params;
+    params.disagreement = rule;
+    params.max_parallax_deg = 180.0;
+    MultiViewTest test(camera(), params);
+    int dynamic = 0, agreeing = 0, mismatches = 0;
+    for (int frame = 0; frame < 2; ++frame) {
+      test.set_frame(Pose::Identity(), references);  // same view: the pixel maps to itself
+      for (int i = 0; i < 20000; ++i) {
+        const int u = std::uniform_int_distribution<int>(4, 635)(rng);
+        const int v = std::uniform_int_distribution<int>(4, 475)(rng);
+        const double measured = depth.at<float>(v, u);
+        const double point_depth = (measured > 0.0 ? measured : 2.0) + offset(rng);
+        const MultiViewVerdict verdict = test.evaluate({{double(u), double(v)}, point_depth});
+        const bool expected = patch_votes_dynamic(depth, u, v, 4, point_depth, params);
+        mismatches += verdict.dynamic != expected;
+        dynamic += expected;
+        agreeing += !expected && verdict.valid_references == 1;
+      }
+    }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_GT(dynamic, 5000);  // both outcomes are exercised
+    EXPECT_GT(agreeing, 5000);
+  }
 }
 
 TEST(MultiViewTest, ParamsFromYamlNameTheKey) {

@@ -1,8 +1,10 @@
 #include "pspslam/geometry/geometry_stage.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <functional>
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/config/yaml_section.h"
@@ -144,17 +146,22 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   }
 
   // Reference views: the most covering ones of a larger pool (DynaSLAM: most overlapping).
+  // The test gets them oldest first (the pool is ordered newest first): a mover has had the most
+  // time to leave its place in the oldest view, so that view most often gives the dynamic vote
+  // that ends the test of a dynamic point early. The verdict does not depend on the order.
   const Stopwatch selection_start;
-  std::span<const DepthView> references = input.references;
-  if (references.size() > static_cast<size_t>(params_.multiview.max_reference_views)) {
+  selected_references_.clear();
+  if (input.references.size() > static_cast<size_t>(params_.multiview.max_reference_views)) {
     // The selector estimates coverage on every point_stride-th candidate: only those need depths.
     for (size_t i = 0; i < n; i += static_cast<size_t>(params_.references.point_stride))
       depth_of(i);
-    selected_references_.clear();
-    for (int v : selector_.select(input.T_world_camera, candidates_, input.references))
-      selected_references_.push_back(input.references[v]);
-    references = selected_references_;
+    selected_pool_indices_ = selector_.select(input.T_world_camera, candidates_, input.references);
+    std::sort(selected_pool_indices_.begin(), selected_pool_indices_.end(), std::greater<>());
+    for (int v : selected_pool_indices_) selected_references_.push_back(input.references[v]);
+  } else {
+    selected_references_.assign(input.references.rbegin(), input.references.rend());
   }
+  const std::span<const DepthView> references = selected_references_;
   result.references_used = static_cast<int>(references.size());
   result.timing.selection_ms = selection_start.wall_ms();
   result.timing.selection_cpu_ms = selection_start.cpu_ms();

@@ -112,7 +112,8 @@ class GeometryStage {
   std::vector<Eigen::Vector2f> points_;
   std::vector<CandidatePoint> candidates_;
   std::vector<int> priority_;
-  std::vector<DepthView> selected_references_;
+  std::vector<int> selected_pool_indices_;
+  std::vector<DepthView> selected_references_;  // oldest first
   std::vector<Eigen::Vector2f> seeds_;
   std::vector<float> seed_depths_;
   std::vector<Eigen::Vector2f> static_points_;

@@ -10,7 +10,8 @@
 //    frames, cpu_ms the median CPU time of the whole process (all OpenCV threads) per frame.
 //    On the shared, loaded machine wall time includes waiting for a core; CPU time does not.
 // 3. With --profile, first prints per model the median wall time of the stages of segment()
-//    (pre-processing, network, post-processing) and of the network's layers summed by type
+//    (pre-processing, network, post-processing), of dynamic_mask() (run after segment() by the
+//    semantic thread) and of the network's layers summed by type
 //    (cv::dnn::Net::getPerfProfile), over the same frames.
 // Needs ../shared (PSPSLAM_SHARED); defaults to our PSPNet at its three exported sizes and the
 // three teachers.
@@ -35,6 +36,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/semantic/onnx_segmenter.h"
+#include "pspslam/semantic/semantic_params.h"
 
 namespace {
 
@@ -97,11 +99,18 @@ void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames)
   const std::vector<std::string> names = net.getLayerNames();
   std::vector<std::string> layer_types;
   for (const std::string& name : names) layer_types.push_back(net.getLayer(name)->type);
-  std::vector<double> pre, network, post;
+  const std::vector<int> dynamic_ids = segmenter.default_dynamic_classes();
+  const int dilation_px = pspslam::SemanticParams{}.mask_dilation_px;
+  std::vector<double> pre, network, post, mask;
   std::map<std::string, std::vector<double>> by_type;
   std::vector<double> layer_ticks;
   for (const cv::Mat& frame : frames) {
-    segmenter.segment(frame);
+    const pspslam::LabelMap labels = segmenter.segment(frame);
+    const auto mask_start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(pspslam::dynamic_mask(labels, dynamic_ids, dilation_px));
+    mask.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - mask_start)
+            .count());
     const auto& stages = segmenter.last_stage_times();
     pre.push_back(stages.preprocess_ms);
     network.push_back(stages.network_ms);
@@ -116,9 +125,10 @@ void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames)
   const auto& meta = segmenter.metadata();
   std::printf(
       "%s %dx%d, median over %zu frames: pre-processing %.2f ms, network %.2f ms, "
-      "post-processing %.2f ms\n  network layers by type (ms):",
+      "post-processing %.2f ms; dynamic_mask (%d px dilation, semantic thread) %.2f ms"
+      "\n  network layers by type (ms):",
       meta.name.c_str(), meta.input_width, meta.input_height, frames.size(), median(pre),
-      median(network), median(post));
+      median(network), median(post), dilation_px, median(mask));
   for (const auto& [type, ms] : by_type) std::printf(" %s %.2f", type.c_str(), median(ms));
   std::printf("\n");
   std::fflush(stdout);

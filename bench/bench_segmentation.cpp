@@ -1,7 +1,7 @@
 // Segmentation accuracy and speed through the C++ path (OpenCV DNN, CPU).
 //
 //   bench_segmentation [--models a.yaml,b.yaml] [--threads 2] [--frames 20] [--no-iou]
-//                      [--profile] [google-benchmark flags]
+//                      [--profile] [--no-fusion] [google-benchmark flags]
 //
 // 1. Prints the person IoU (mean over the human_seg validation split of
 //    models/pspnet/human_seg_split.json, masks resized to the photo) of each model.
@@ -12,7 +12,8 @@
 // 3. With --profile, first prints per model the median wall time of the stages of segment()
 //    (pre-processing, network, post-processing), of dynamic_mask() (run after segment() by the
 //    semantic thread) and of the network's layers summed by type
-//    (cv::dnn::Net::getPerfProfile), over the same frames.
+//    (cv::dnn::Net::getPerfProfile), over the same frames, and the DNN backend/target pairs
+//    this OpenCV build offers. --no-fusion disables OpenCV's layer fusion (for comparison).
 // Needs ../shared (PSPSLAM_SHARED); defaults to our PSPNet at its three exported sizes and the
 // three teachers.
 #include <benchmark/benchmark.h>
@@ -49,6 +50,7 @@ struct Options {
   int frames = 20;
   bool iou = true;
   bool profile = false;
+  bool fusion = true;
 };
 
 double median(std::vector<double> v) {
@@ -154,6 +156,8 @@ Options parse(int* argc, char** argv) {
       o.iou = false;
     } else if (a == "--profile") {
       o.profile = true;
+    } else if (a == "--no-fusion") {
+      o.fusion = false;
     } else {
       rest.push_back(argv[i]);
     }
@@ -197,17 +201,28 @@ int main(int argc, char** argv) {
       }
     }
     if (options.profile) {
-      for (const fs::path& m : options.models) print_profile(*OnnxSegmenter::from_file(m), frames);
+      std::printf("DNN backend/target pairs available:");
+      for (const auto& [backend, target] : cv::dnn::getAvailableBackends()) {
+        std::printf(" %d/%d", backend, target);
+      }
+      std::printf(" (3/0 = DNN_BACKEND_OPENCV/DNN_TARGET_CPU)\n");
+      for (const fs::path& m : options.models) {
+        auto segmenter = OnnxSegmenter::from_file(m);
+        segmenter->network().enableFusion(options.fusion);
+        print_profile(*segmenter, frames);
+      }
     }
     for (const fs::path& m : options.models) {
       auto meta = pspslam::load_segmenter_metadata(m);
       const std::string name = meta.name + "/" + std::to_string(meta.input_width) + "x" +
                                std::to_string(meta.input_height) +
-                               "/threads:" + std::to_string(options.threads);
+                               "/threads:" + std::to_string(options.threads) +
+                               (options.fusion ? "" : "/no-fusion");
       benchmark::RegisterBenchmark(
           name.c_str(),
-          [meta, &frames](benchmark::State& state) {
+          [meta, &frames, fusion = options.fusion](benchmark::State& state) {
             OnnxSegmenter segmenter(meta);
+            segmenter.network().enableFusion(fusion);
             segmenter.segment(frames.front());  // one-off set-up outside the timing
             std::vector<double> ms;
             std::vector<double> cpu_ms;

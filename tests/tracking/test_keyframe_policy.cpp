@@ -23,7 +23,7 @@ TEST(KeyFramePolicy, NoKeyFrameWhileTrackingTheReferenceWell) {
 
 TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   KeyFrameEvidence e = steady_tracking();
-  e.tracked_inliers = 300;  // < 0.75 * 450, mapper idle
+  e.tracked_inliers = 300;  // < 0.85 * 450, mapper idle
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
   e.mapper_idle = false;
   e.last_keyframe_frame_id = 99;
@@ -32,6 +32,17 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
   e.mapper_queue = 3;
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInterruptMapper);
+}
+
+TEST(KeyFramePolicy, TrackedRatioToReferenceIsTheThreshold) {
+  KeyFrameEvidence e = steady_tracking();
+  e.tracked_inliers = 370;  // 0.82 of the reference's 450 points
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  KeyFramePolicyOptions orb_slam2;
+  orb_slam2.tracked_ratio_to_reference = 0.75;
+  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kSkip);
+  e.tracked_inliers = 330;  // 0.73
+  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kInsert);
 }
 
 TEST(KeyFramePolicy, KeyFrameWhenCloseStructureIsUntracked) {

@@ -11,7 +11,9 @@ KeyFrameDecision decide_keyframe(const KeyFrameEvidence& e, const KeyFramePolicy
   }
   const bool need_close = e.tracked_close_points < o.close_tracked_limit &&
                           e.untracked_close_points > o.close_untracked_min;
-  const double ratio_threshold = e.keyframes_in_map < 2 ? 0.4 : 0.75;
+  const double ratio_threshold = e.keyframes_in_map < 2
+                                     ? o.tracked_ratio_to_reference_first_keyframes
+                                     : o.tracked_ratio_to_reference;
   const bool due = e.frame_id >= e.last_keyframe_frame_id + o.max_frames_between;
   const bool idle_and_allowed =
       e.frame_id >= e.last_keyframe_frame_id + o.min_frames_between && e.mapper_idle;

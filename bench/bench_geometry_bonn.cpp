@@ -401,6 +401,17 @@ int main(int argc, char** argv) {
       "%.3f ms (cpu medians)\n",
       median(ant_no_h), median(ex_no_h), median(ant_no_h) / median(ex_no_h), median(selection),
       median(ant_region), median(ex_region));
+  {
+    std::vector<double> crowd_tested, static_tested;
+    for (size_t k = 0; k < stage_frames.size(); ++k) {
+      const int index = frame_index[stage_frames[k].index];
+      if (index >= 220) crowd_tested.push_back(tested_share[k]);
+      if (index < 215) static_tested.push_back(tested_share[k]);
+    }
+    std::printf(
+        "  ant colony tested share (median): static frames <215 %.3f, crowd frames >=220 %.3f\n",
+        median(static_tested), median(crowd_tested));
+  }
   std::printf(
       "  dynamic share of keypoints (ant colony, final flags): static room frames <215 "
       "%.4f, crowd frames >=220 %.4f\n",

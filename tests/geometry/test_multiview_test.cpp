@@ -131,10 +131,10 @@ bool patch_votes_dynamic(const cv::Mat& depth, int u, int v, int r, double proje
   return valid && !agrees;
 }
 
-// The cached block bounds, the centre shortcut and the branch-free scan must give the verdict of
-// the plain rule on every point: a depth image of random boxes (edges everywhere) with 10 %
-// holes, points near the measured depths, both disagreement rules, the cache reused over frames.
-TEST(MultiViewTest, ShortcutsMatchThePlainPatchRule) {
+// The centre shortcut and the branch-free patch scan must give the verdict of the plain rule on
+// every point: a depth image of random boxes (edges everywhere) with 10 % holes, points near the
+// measured depths, both disagreement rules.
+TEST(MultiViewTest, PatchScanMatchesThePlainPatchRule) {
   std::mt19937 rng(11);
   cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.5f));
   std::uniform_int_distribution<int> x_of(0, 639), y_of(0, 479), size_of(4, 60);

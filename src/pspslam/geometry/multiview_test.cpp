@@ -10,9 +10,6 @@
 namespace pspslam {
 namespace {
 
-// Side of the blocks whose depth bounds are cached per reference (see CachedBounds).
-constexpr int kBlock = 8;
-
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
   if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
 }
@@ -62,46 +59,8 @@ MultiViewTest::MultiViewTest(PinholeCamera camera, MultiViewParams params)
   cos_max_parallax_ = std::cos(params_.max_parallax_deg * M_PI / 180.0);
 }
 
-MultiViewTest::CachedBounds& MultiViewTest::bounds_for(const cv::Mat& depth) {
-  for (const std::unique_ptr<CachedBounds>& entry : bounds_cache_) {
-    if (entry->depth.data == depth.data && entry->depth.size() == depth.size()) {
-      entry->used = true;
-      return *entry;
-    }
-  }
-  auto entry = std::make_unique<CachedBounds>();
-  entry->depth = depth;
-  entry->block_cols = (depth.cols + kBlock - 1) / kBlock;
-  const int block_rows = (depth.rows + kBlock - 1) / kBlock;
-  entry->blocks.assign(static_cast<size_t>(entry->block_cols) * block_rows,
-                       {std::numeric_limits<float>::quiet_NaN(), 0.0f});
-  entry->used = true;
-  bounds_cache_.push_back(std::move(entry));
-  return *bounds_cache_.back();
-}
-
-const MultiViewTest::BlockBounds& MultiViewTest::block(CachedBounds& bounds, int block_x,
-                                                       int block_y) {
-  BlockBounds& b = bounds.blocks[static_cast<size_t>(block_y) * bounds.block_cols + block_x];
-  if (std::isnan(b.min)) {
-    b = {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()};
-    const int x0 = block_x * kBlock, x1 = std::min(bounds.depth.cols, x0 + kBlock);
-    const int y1 = std::min(bounds.depth.rows, (block_y + 1) * kBlock);
-    for (int y = block_y * kBlock; y < y1; ++y) {
-      const float* row = bounds.depth.ptr<float>(y);
-      for (int x = x0; x < x1; ++x) {
-        if (!(row[x] > 0.0f)) continue;
-        b.min = std::min(b.min, row[x]);
-        b.max = std::max(b.max, row[x]);
-      }
-    }
-  }
-  return b;
-}
-
 void MultiViewTest::set_frame(const Pose& T_world_current, std::span<const DepthView> references) {
   references_.clear();
-  for (const std::unique_ptr<CachedBounds>& entry : bounds_cache_) entry->used = false;
   const size_t count =
       std::min(references.size(), static_cast<size_t>(params_.max_reference_views));
   for (size_t i = 0; i < count; ++i) {
@@ -113,14 +72,11 @@ void MultiViewTest::set_frame(const Pose& T_world_current, std::span<const Depth
     const Pose T_ref_current = view.T_world_camera.inverse() * T_world_current;
     const Pose T_current_ref = T_ref_current.inverse();
     references_.push_back({T_ref_current.linear(), T_ref_current.translation(),
-                           T_current_ref.translation(), view.depth, &bounds_for(view.depth)});
+                           T_current_ref.translation(), view.depth});
   }
-  // Views that are no longer references leave the cache (and release their depth images).
-  std::erase_if(bounds_cache_,
-                [](const std::unique_ptr<CachedBounds>& entry) { return !entry->used; });
 }
 
-MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) {
+MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
   MultiViewVerdict verdict;
   if (!(point.depth >= params_.min_depth_m && point.depth <= params_.max_depth_m)) return verdict;
   const Eigen::Vector3d p_current = camera_.unproject(point.pixel, point.depth);
@@ -152,29 +108,16 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) {
                             ? 0.0f
                             : static_cast<float>(projected_depth - threshold);
     // The reference agrees when any valid pixel of the patch is consistent with the point. The
-    // centre settles it for most static points (one read); the cached block bounds settle most
-    // dynamic votes (a dynamic point would otherwise read every pixel: "every valid pixel
-    // disagrees"). What is left scans the whole patch without a data-dependent branch: its 2r+1
-    // rows lie in different cache lines, and a branch-free scan issues their loads together.
+    // centre settles it for most static points (one read). Otherwise the whole patch is scanned
+    // without a data-dependent branch: its 2r+1 rows lie in different cache lines, and a
+    // branch-free scan issues their loads together instead of one after another (a dynamic point
+    // must read every pixel anyway: "every valid pixel disagrees"). Measured and dropped: per
+    // reference cached 8x8-block depth bounds to settle dynamic votes without the scan
+    // (docs/geometry.md).
     const float centre = ref.depth.ptr<float>(v)[u];
     bool consistent = centre > 0.0f && centre >= lower && centre <= upper;
     int valid_pixels = centre > 0.0f;
-    bool settled = consistent;
-    if (!consistent && centre > 0.0f) {
-      // The centre is a valid disagreeing pixel. If every valid pixel of the blocks that contain
-      // the patch lies outside [lower, upper], so does every pixel of the patch: dynamic vote.
-      float block_min = std::numeric_limits<float>::infinity();
-      float block_max = -std::numeric_limits<float>::infinity();
-      for (int by = (v - r) / kBlock; by <= (v + r) / kBlock; ++by) {
-        for (int bx = (u - r) / kBlock; bx <= (u + r) / kBlock; ++bx) {
-          const BlockBounds& b = block(*ref.bounds, bx, by);
-          block_min = std::min(block_min, b.min);
-          block_max = std::max(block_max, b.max);
-        }
-      }
-      settled = block_min > upper || block_max < lower;
-    }
-    if (!consistent && !settled) {
+    if (!consistent) {
       int agree = 0;
       for (int dv = -r; dv <= r; ++dv) {
         const float* row = ref.depth.ptr<float>(v + dv) + (u - r);

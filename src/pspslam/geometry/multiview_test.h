@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <memory>
 #include <opencv2/core.hpp>
 #include <span>
 #include <vector>
@@ -65,57 +64,34 @@ struct MultiViewVerdict {
 };
 
 // The test itself. set_frame() precomputes the relative poses once per frame; evaluate() is then
-// allocation-free. It fills a per-reference cache lazily (block depth bounds, see below), so it
-// is not const: use one MultiViewTest per worker thread.
+// allocation-free and const, so one worker thread can call it for thousands of points.
 class MultiViewTest {
  public:
   MultiViewTest(PinholeCamera camera, MultiViewParams params);
 
   // References beyond params.max_reference_views are ignored (the first ones are kept). The
-  // depth images are referenced, not copied: they must outlive the calls to evaluate(), and must
-  // not be written to while a reference with the same buffer is in use (block bounds are cached
-  // by buffer address across frames, as keyframes stay references for many frames).
+  // depth images are referenced, not copied: they must outlive the calls to evaluate().
   void set_frame(const Pose& T_world_current, std::span<const DepthView> references);
 
   // References are tried in the order given; with a vote fraction one vote reaches, the first
   // dynamic vote ends the test (the verdict does not depend on the order).
-  MultiViewVerdict evaluate(const CandidatePoint& point);
-  bool is_dynamic(const CandidatePoint& point) { return evaluate(point).dynamic; }
+  MultiViewVerdict evaluate(const CandidatePoint& point) const;
+  bool is_dynamic(const CandidatePoint& point) const { return evaluate(point).dynamic; }
 
   const MultiViewParams& params() const { return params_; }
 
  private:
-  // Depth bounds over the valid pixels of one kBlock x kBlock block of a reference depth image
-  // (min > max: no valid pixel; NaN min: not computed yet).
-  struct BlockBounds {
-    float min;
-    float max;
-  };
-  // Per reference depth image, computed block by block when a test first needs a block: when
-  // every valid pixel of the blocks around a projection lies outside the agreement interval, so
-  // does every valid pixel of the patch, and a dynamic vote costs a few reads of this small table
-  // instead of the (2r+1)^2 patch pixels spread over 2r+1 cache lines of the depth image.
-  struct CachedBounds {
-    cv::Mat depth;  // shallow: keeps the buffer (whose address is the key) alive
-    int block_cols = 0;
-    std::vector<BlockBounds> blocks;
-    bool used = false;
-  };
   struct Reference {
     Eigen::Matrix3d R_ref_current;
     Eigen::Vector3d t_ref_current;
     Eigen::Vector3d center_in_current;  // reference camera centre in current-camera coordinates
     cv::Mat depth;                      // shallow header
-    CachedBounds* bounds = nullptr;     // entry of bounds_cache_, stable until the next frame
   };
-  CachedBounds& bounds_for(const cv::Mat& depth);
-  const BlockBounds& block(CachedBounds& bounds, int block_x, int block_y);
 
   PinholeCamera camera_;
   MultiViewParams params_;
   double cos_max_parallax_ = 0.0;
   std::vector<Reference> references_;
-  std::vector<std::unique_ptr<CachedBounds>> bounds_cache_;
 };
 
 }  // namespace pspslam

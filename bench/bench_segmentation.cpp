@@ -11,7 +11,7 @@
 //    On the shared, loaded machine wall time includes waiting for a core; CPU time does not.
 // 3. With --profile, first prints per model the median wall time of the stages of segment()
 //    (pre-processing, network, post-processing), of dynamic_mask() (run after segment() by the
-//    semantic thread) and of the network's layers summed by type
+//    semantic thread) and of the network's layers summed by type and the five slowest layers
 //    (cv::dnn::Net::getPerfProfile), over the same frames, and the DNN backend/target pairs
 //    this OpenCV build offers. --no-fusion disables OpenCV's layer fusion (for comparison).
 // Needs ../shared (PSPSLAM_SHARED); defaults to our PSPNet at its three exported sizes and the
@@ -28,10 +28,12 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pspslam/core/error.h"
@@ -105,6 +107,7 @@ void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames)
   const int dilation_px = pspslam::SemanticParams{}.mask_dilation_px;
   std::vector<double> pre, network, post, mask;
   std::map<std::string, std::vector<double>> by_type;
+  std::vector<std::vector<double>> by_layer(names.size());
   std::vector<double> layer_ticks;
   for (const cv::Mat& frame : frames) {
     const pspslam::LabelMap labels = segmenter.segment(frame);
@@ -120,7 +123,9 @@ void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames)
     net.getPerfProfile(layer_ticks);  // indexed like getLayerNames()
     std::map<std::string, double> sums;
     for (size_t i = 0; i < layer_ticks.size() && i < layer_types.size(); ++i) {
-      sums[layer_types[i]] += 1000.0 * layer_ticks[i] / cv::getTickFrequency();
+      const double ms = 1000.0 * layer_ticks[i] / cv::getTickFrequency();
+      sums[layer_types[i]] += ms;
+      by_layer[i].push_back(ms);
     }
     for (const auto& [type, ms] : sums) by_type[type].push_back(ms);
   }
@@ -132,6 +137,17 @@ void print_profile(OnnxSegmenter& segmenter, const std::vector<cv::Mat>& frames)
       meta.name.c_str(), meta.input_width, meta.input_height, frames.size(), median(pre),
       median(network), median(post), dilation_px, median(mask));
   for (const auto& [type, ms] : by_type) std::printf(" %s %.2f", type.c_str(), median(ms));
+  std::vector<std::pair<double, size_t>> slowest;
+  for (size_t i = 0; i < by_layer.size(); ++i) {
+    if (!by_layer[i].empty()) slowest.emplace_back(median(by_layer[i]), i);
+  }
+  const size_t shown = std::min<size_t>(5, slowest.size());
+  std::partial_sort(slowest.begin(), slowest.begin() + static_cast<std::ptrdiff_t>(shown),
+                    slowest.end(), std::greater<>());
+  std::printf("\n  slowest layers (ms):");
+  for (size_t k = 0; k < shown; ++k) {
+    std::printf(" %s %.2f;", names[slowest[k].second].c_str(), slowest[k].first);
+  }
   std::printf("\n");
   std::fflush(stdout);
 }

@@ -64,6 +64,50 @@ TEST(GeometryStage, DetectsPeopleAndCarriedBoxInGeometryTestScene) {
   EXPECT_GT(result.timing.total_ms, 0.0);
 }
 
+// System computes the compensated homography in its flow step and passes it with the unwarped
+// previous mask: the stage must use that H (not estimate one from matches) to map the mask.
+TEST(GeometryStage, UsesTheGivenHomographyForThePreviousMask) {
+  PinholeCamera camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = camera.fy = 525.0;
+  camera.cx = 319.5;
+  camera.cy = 239.5;
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.0f));
+  cv::Mat previous_mask = cv::Mat::zeros(480, 640, CV_8UC1);
+  previous_mask(cv::Rect(100, 150, 80, 200)).setTo(255);
+  Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
+  H(0, 2) = 25.0;  // the scene moved 25 px to the right
+  H(1, 2) = -10.0;
+  // Matches of a different motion: they must be ignored when H is given.
+  const std::vector<Eigen::Vector2d> previous{
+      {10, 10}, {600, 20}, {30, 450}, {620, 460}, {300, 200}};
+  std::vector<Eigen::Vector2d> current;
+  for (const Eigen::Vector2d& p : previous) current.push_back(p + Eigen::Vector2d(-40.0, 0.0));
+  const std::vector<Eigen::Vector2d> keypoints{{140.0, 250.0}, {165.0, 240.0}, {400.0, 300.0}};
+
+  GeometryParams params;
+  params.output_warped_previous_mask = true;
+  GeometryStage stage(camera, params);
+  GeometryFrameInput input;
+  input.depth = depth;
+  input.keypoints = keypoints;
+  input.matched_previous = previous;
+  input.matched_current = current;
+  input.H_previous_to_current = H;
+  input.previous_dynamic_mask = previous_mask;
+  const GeometryFrameResult result = stage.process(input);
+
+  EXPECT_FALSE(result.homography.valid);  // nothing estimated
+  const cv::Mat expected = warp_to_current(previous_mask, H, depth.size(), true);
+  EXPECT_EQ(cv::countNonZero(result.warped_previous_mask != expected), 0);
+  EXPECT_EQ(cv::countNonZero(result.warped_previous_mask), 80 * 200);
+  // (140, 250) maps back to (115, 260), inside the previous mask: a priority point, tested first.
+  // (165, 240) maps to (140, 250), also inside; (400, 300) is tested only if the path passes it.
+  EXPECT_EQ(result.keypoint_tested[0], 1);
+  EXPECT_EQ(result.keypoint_tested[1], 1);
+}
+
 TEST(GeometryStage, FuseMasksIsDilatedOr) {
   cv::Mat semantic = cv::Mat::zeros(100, 100, CV_8UC1), geometry = semantic.clone();
   semantic.at<std::uint8_t>(10, 10) = 15;  // label values count as dynamic

@@ -91,16 +91,19 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   // III.B: camera-motion compensation of the previous frame (eq. 10-11).
   const cv::Mat& previous_mask = input.previous_dynamic_mask;
   const bool have_previous_mask = !previous_mask.empty() && previous_mask.type() == CV_8UC1;
-  Eigen::Matrix3d current_to_previous = Eigen::Matrix3d::Identity();
-  if (input.matched_previous.size() >= 4) {
+  std::optional<Eigen::Matrix3d> previous_to_current = input.H_previous_to_current;
+  if (!previous_to_current && input.matched_previous.size() >= 4) {
     result.homography = estimate_compensated_homography(input.matched_previous,
                                                         input.matched_current, params_.homography);
-    if (result.homography.valid) current_to_previous = result.homography.H.inverse();
+    if (result.homography.valid) previous_to_current = result.homography.H;
   }
+  const Eigen::Matrix3d current_to_previous = previous_to_current
+                                                  ? Eigen::Matrix3d(previous_to_current->inverse())
+                                                  : Eigen::Matrix3d::Identity();
   if (have_previous_mask && params_.output_warped_previous_mask) {
     result.warped_previous_mask =
-        result.homography.valid
-            ? warp_to_current(previous_mask, result.homography.H, input.depth.size(), true)
+        previous_to_current
+            ? warp_to_current(previous_mask, *previous_to_current, input.depth.size(), true)
             : previous_mask.clone();
   }
   result.timing.homography_ms = start.wall_ms();

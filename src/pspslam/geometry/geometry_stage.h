@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -56,6 +57,10 @@ struct GeometryFrameInput {
   // Matches previous -> current for the compensated homography; fewer than 4 skips it.
   std::span<const Eigen::Vector2d> matched_previous;
   std::span<const Eigen::Vector2d> matched_current;
+  // A compensated homography previous -> current computed by the caller (System does it in its
+  // flow step): used instead of the matches, so the previous mask need not be warped beforehand
+  // (each keypoint is mapped back through its inverse).
+  std::optional<Eigen::Matrix3d> H_previous_to_current;
   cv::Mat previous_dynamic_mask;  // optional CV_8UC1 (non-zero = dynamic) of the previous frame
 };
 

@@ -244,10 +244,12 @@ class System::DynamicPipeline {
       input.T_world_camera = *prior_pose();
       input.keypoints = pixels_;
       input.references = views_;
-      // Already in this frame's coordinates, so the stage needs no homography of its own.
-      if (!previous_mask_.empty() && H_previous_to_current_)
-        input.previous_dynamic_mask =
-            warp_to_current(previous_mask_, *H_previous_to_current_, depth.size(), true);
+      // The stage maps each keypoint back through the flow step's H into the previous mask, so
+      // the mask needs no full-image warp here.
+      if (!previous_mask_.empty() && H_previous_to_current_) {
+        input.previous_dynamic_mask = previous_mask_;
+        input.H_previous_to_current = H_previous_to_current_;
+      }
       GeometryFrameResult result = geometry_->process(input);
       report.geometry_ms = milliseconds_since(start);
       report.geometry_search_ms = result.timing.search_ms;

@@ -213,7 +213,8 @@ TEST(RunCommand, InterruptWritesTrajectoryAndStats) {
 // as accurate as on the static twin (measured 0.011 m both, bench/results/modes.csv). Plain
 // SLAM (`off`) is not compared here: whether it survives this sequence depends on the core's
 // outlier handling, which changed while this was written (0.235 m -> 0.006 m; see the report).
-// Geometry-only keeps the segmentation network's run time out of the test.
+// Geometry-only keeps the segmentation network's run time out of the test. A second run must
+// reproduce the first trajectory exactly.
 TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSequence) {
   const std::filesystem::path dir = testing::make_temp_dir("run_dynamic_geometry");
   SynthOptions options = static_room(300);
@@ -238,6 +239,17 @@ TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSeque
   EXPECT_GT(total("tested_points"), 10000) << stats;
   EXPECT_GT(total("dynamic_points"), 500) << stats;  // people and the box were found
   EXPECT_GT(total("masked_keypoints"), 500) << stats;
+
+  // Deterministic mode repeats exactly: the geometry stage and the dynamic-point culler read
+  // keyframe poses and map points only after local mapping has finished with them.
+  ASSERT_EQ(testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
+                                   (dir / "sequence").string() + " --dynamic geometry --out " +
+                                   (dir / "again").string(),
+                               &output),
+            0)
+      << output;
+  EXPECT_EQ(read_text(dir / "out" / "trajectory.txt"), read_text(dir / "again" / "trajectory.txt"))
+      << "two deterministic runs of the same sequence gave different trajectories";
 }
 
 }  // namespace

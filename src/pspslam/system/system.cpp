@@ -521,6 +521,10 @@ FrameReport System::process(const RgbdFrame& frame) {
   report.tracking = tracker_->track(std::move(tracked_frame));
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
+  // The culler below and the next frame's geometry stage read map points and keyframe poses that
+  // local mapping refines: a deterministic run lets it finish this frame's keyframe first, or the
+  // result would depend on thread timing (bonn `exhaustive` varied 0.0183-0.0199 m run to run).
+  wait_for_local_mapping_if_synchronous();
   dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
   return report;
 }

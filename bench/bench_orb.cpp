@@ -7,11 +7,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include <algorithm>
 #include <filesystem>
 #include <vector>
 
-#include "pspslam/core/shared_paths.h"
+#include "bonn_clip.h"
+
 #include "pspslam/feature/hamming.h"
 #include "pspslam/feature/orb_extractor.h"
 
@@ -19,14 +19,7 @@ namespace {
 
 // Every 20th frame of the clip: static room and people walking, so the timing is not one image's.
 std::vector<cv::Mat> load_frames() {
-  const std::filesystem::path folder = pspslam::shared_dir() / "data" / "bonn_crowd_dev" / "rgb";
-  std::vector<std::filesystem::path> files;
-  if (std::filesystem::is_directory(folder)) {
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-      if (entry.path().extension() == ".jpg") files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = pspslam::bench::bonn_rgb_files();
   std::vector<cv::Mat> frames;
   for (std::size_t i = 0; i < files.size(); i += 20) {
     frames.push_back(cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE));

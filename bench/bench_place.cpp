@@ -13,11 +13,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include <algorithm>
 #include <filesystem>
 #include <vector>
 
-#include "pspslam/core/shared_paths.h"
+#include "bonn_clip.h"
+
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/place/bow_matching.h"
 #include "pspslam/place/place_recognition.h"
@@ -26,14 +26,7 @@ namespace {
 
 // Descriptors of every 20th frame of the clip.
 std::vector<cv::Mat> load_descriptors() {
-  const std::filesystem::path folder = pspslam::shared_dir() / "data" / "bonn_crowd_dev" / "rgb";
-  std::vector<std::filesystem::path> files;
-  if (std::filesystem::is_directory(folder)) {
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-      if (entry.path().extension() == ".jpg") files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = pspslam::bench::bonn_rgb_files();
   pspslam::OrbExtractor extractor{pspslam::OrbConfig{}};
   pspslam::OrbFeatures features;
   std::vector<cv::Mat> descriptors;

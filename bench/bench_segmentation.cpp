@@ -36,6 +36,7 @@
 #include <utility>
 #include <vector>
 
+#include "bonn_clip.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/semantic/onnx_segmenter.h"
@@ -82,12 +83,8 @@ double validation_iou(OnnxSegmenter& segmenter, const fs::path& shared, int* cou
   return sum / *count;
 }
 
-std::vector<cv::Mat> bonn_frames(const fs::path& shared, int count) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(shared / "data" / "bonn_crowd_dev" / "rgb")) {
-    files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
+std::vector<cv::Mat> bonn_frames(int count) {
+  const std::vector<fs::path> files = pspslam::bench::bonn_rgb_files();
   std::vector<cv::Mat> frames;
   // Frames with people (from ~220 on), spread over the clip.
   for (size_t i = 220; i < files.size() && static_cast<int>(frames.size()) < count; i += 8) {
@@ -203,7 +200,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     cv::setNumThreads(options.threads);
-    const std::vector<cv::Mat> frames = bonn_frames(shared, options.frames);
+    const std::vector<cv::Mat> frames = bonn_frames(options.frames);
     if (options.iou) {
       std::printf("%-34s %-9s %s\n", "model", "input", "person IoU (human_seg validation)");
       for (const fs::path& m : options.models) {

@@ -67,12 +67,7 @@ TEST(GeometryStage, DetectsPeopleAndCarriedBoxInGeometryTestScene) {
 // System computes the compensated homography in its flow step and passes it with the unwarped
 // previous mask: the stage must use that H (not estimate one from matches) to map the mask.
 TEST(GeometryStage, UsesTheGivenHomographyForThePreviousMask) {
-  PinholeCamera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 525.0;
-  camera.cx = 319.5;
-  camera.cy = 239.5;
+  const PinholeCamera camera;  // 640x480, f = 525 px
   const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(3.0f));
   cv::Mat previous_mask = cv::Mat::zeros(480, 640, CV_8UC1);
   previous_mask(cv::Rect(100, 150, 80, 200)).setTo(255);

@@ -15,14 +15,12 @@
 # usage: bench/run_loop.sh [BUILD_DIR (default build)] [WORK_DIR (default /tmp/pspslam_loop)]
 #        RUNS=3 BONN=1 bench/run_loop.sh ...      (BONN=0 skips bonn_crowd_dev)
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$(dirname "$0")/common.sh"
 build="${1:-$root/build}"
 work="${2:-/tmp/pspslam_loop}"
 runs="${RUNS:-3}"
 bonn="${BONN:-1}"
-cli="$build/apps/pspslam"
-shared="${PSPSLAM_SHARED:-$root/../shared}"
-[[ -x "$cli" ]] || { echo "error: $cli not built (cmake --build $build --target pspslam_cli)" >&2; exit 2; }
+require_cli "$build"
 mkdir -p "$work"
 
 sequence="$work/loop_900_1.5turns"

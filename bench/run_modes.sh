@@ -13,15 +13,13 @@
 #   BUILD=build WORK=/tmp/pspslam_modes REALTIME=0 bench/run_modes.sh
 # Existing runs (OUT/stats.json present) are kept, so an interrupted benchmark resumes.
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$(dirname "$0")/common.sh"
 build="${BUILD:-$root/build}"
 work="${WORK:-/tmp/pspslam_modes}"
 runs="${RUNS:-5}"
 modes="${MODES:-off semantic geometry full exhaustive}"
 sequences="${SEQUENCES:-synth_dynamic synth_static bonn}"
-cli="$build/apps/pspslam"
-shared="${PSPSLAM_SHARED:-$root/../shared}"
-[[ -x "$cli" ]] || { echo "error: $cli not built (cmake --build $build --target pspslam_cli)" >&2; exit 2; }
+require_cli "$build"
 mkdir -p "$work" "$root/bench/results"
 
 declare -A seq_dir seq_config

@@ -14,12 +14,10 @@
 #
 # usage: bench/run_place_recognition.sh [BUILD_DIR (default build)] [WORK_DIR]
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$(dirname "$0")/common.sh"
 build="${1:-$root/build}"
 work="${2:-/tmp/pspslam_place}"
-cli="$build/apps/pspslam"
-shared="${PSPSLAM_SHARED:-$root/../shared}"
-[[ -x "$cli" ]] || { echo "error: $cli not built (cmake --build $build --target pspslam_cli)" >&2; exit 2; }
+require_cli "$build"
 mkdir -p "$work"
 
 synthetic="$work/static_600"

@@ -13,13 +13,11 @@
 # frame waits for local mapping), so runs of one sequence give the same trajectory; the static
 # sequence is still run RUNS times to show it.
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
+source "$(dirname "$0")/common.sh"
 build="${1:-$root/build}"
 work="${2:-/tmp/pspslam_bench}"
 runs="${RUNS:-3}"
-cli="$build/apps/pspslam"
-shared="${PSPSLAM_SHARED:-$root/../shared}"
-[[ -x "$cli" ]] || { echo "error: $cli not built (cmake --build $build --target pspslam_cli)" >&2; exit 2; }
+require_cli "$build"
 mkdir -p "$work"
 
 synth() {  # name frames bodies

@@ -13,7 +13,8 @@
 // picks 5 by coverage (reference_selection.h). Much faster than the PnP harness.
 //
 //   bench_geometry_bonn [--frames N] [--shared DIR] [--poses FILE] [--pool-size N] [--repeats N]
-//                       [--node-spacing PX]
+//                       [--node-spacing PX] [--dump FILE]
+//   --dump FILE: per-frame CSV of the last pass (CPU ms per part and counts of both strategies).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
   float node_spacing = 0.0f;  // > 0: overrides the ant colony's node spacing (comparisons)
   fs::path shared = shared_dir();
   fs::path poses_file;
+  fs::path dump_file;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--frames") max_frames = std::stoi(argv[i + 1]);
@@ -94,6 +96,7 @@ int main(int argc, char** argv) {
     if (key == "--pool-size") pool_size = std::stoi(argv[i + 1]);
     if (key == "--repeats") repeats = std::stoi(argv[i + 1]);
     if (key == "--node-spacing") node_spacing = std::stof(argv[i + 1]);
+    if (key == "--dump") dump_file = argv[i + 1];
   }
   Trajectory poses;
   if (!poses_file.empty()) poses = read_tum_trajectory(poses_file);
@@ -307,6 +310,13 @@ int main(int argc, char** argv) {
       v->clear();
     static_flags = static_points = crowd_flags = crowd_points = kept = found = 0;
     cv::Mat previous_mask;
+    const bool last_pass = pass + 1 == std::max(1, repeats);
+    std::ofstream dump;
+    if (last_pass && !dump_file.empty()) {
+      dump.open(dump_file);
+      dump << "frame,points,strategy,total,homography,selection,search,region,tested,"
+              "tested_dynamic,dynamic\n";
+    }
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const StageFrame& sf = stage_frames[k];
       const size_t i = sf.index;
@@ -328,6 +338,16 @@ int main(int argc, char** argv) {
         e = exhaustive.process(input);
       }
       previous_mask = a.dynamic_mask;
+      if (dump.is_open()) {
+        for (const auto& [name, r] :
+             {std::pair<const char*, const GeometryFrameResult*>{"ant", &a}, {"exhaustive", &e}}) {
+          const GeometryTiming& t = r->timing;
+          dump << frame_index[i] << ',' << frames[i].keypoints.size() << ',' << name << ','
+               << t.total_cpu_ms << ',' << t.homography_cpu_ms << ',' << t.selection_cpu_ms << ','
+               << t.search_cpu_ms << ',' << t.region_cpu_ms << ',' << r->tested_count << ','
+               << r->tested_dynamic_count << ',' << r->dynamic_count << '\n';
+        }
+      }
       ex_cpu.push_back(e.timing.total_cpu_ms);
       ant_cpu.push_back(a.timing.total_cpu_ms);
       ex_wall.push_back(e.timing.total_ms);

@@ -315,7 +315,7 @@ int main(int argc, char** argv) {
     if (last_pass && !dump_file.empty()) {
       dump.open(dump_file);
       dump << "frame,points,strategy,total,homography,selection,search,region,tested,"
-              "tested_dynamic,dynamic\n";
+              "tested_dynamic,dynamic,mask_pixels\n";
     }
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const StageFrame& sf = stage_frames[k];
@@ -345,7 +345,8 @@ int main(int argc, char** argv) {
           dump << frame_index[i] << ',' << frames[i].keypoints.size() << ',' << name << ','
                << t.total_cpu_ms << ',' << t.homography_cpu_ms << ',' << t.selection_cpu_ms << ','
                << t.search_cpu_ms << ',' << t.region_cpu_ms << ',' << r->tested_count << ','
-               << r->tested_dynamic_count << ',' << r->dynamic_count << '\n';
+               << r->tested_dynamic_count << ',' << r->dynamic_count << ','
+               << cv::countNonZero(r->dynamic_mask) << '\n';
         }
       }
       ex_cpu.push_back(e.timing.total_cpu_ms);

@@ -11,9 +11,6 @@
 namespace pspslam {
 namespace {
 
-// Grid cells whose depth sample has not been read yet (depths are >= 0).
-constexpr float kNotSampled = -1.0f;
-
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
   if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
 }
@@ -65,17 +62,21 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
   const int s = params_.stride;
   const int cols = (depth.cols + s - 1) / s;
   const int rows = (depth.rows + s - 1) / s;
-  // Nearest sampling (block centre) keeps depth edges sharp, unlike area averaging. Samples are
-  // taken lazily, when growth first looks at a block: each one reads its own cache line of the
-  // depth image, and sampling the whole grid read as much memory as the rest of the growth.
+  // Nearest sampling (block centre) keeps depth edges sharp, unlike area averaging. A grid row is
+  // sampled as a whole when growth first reaches it: its samples lie on one pixel row, so the
+  // reads stream through consecutive cache lines (sampling cell by cell, in growth order, stalled
+  // on a cache miss every few cells; sampling every row up front read rows no region reaches).
   grid_depth_.create(rows, cols, CV_32FC1);
-  grid_depth_.setTo(kNotSampled);
-  const auto sample = [&](int gx, int gy) {
-    float& value = grid_depth_.ptr<float>(gy)[gx];
-    if (value == kNotSampled)
-      value = depth.ptr<float>(
-          std::min(gy * s + s / 2, depth.rows - 1))[std::min(gx * s + s / 2, depth.cols - 1)];
-    return value;
+  row_sampled_.assign(static_cast<size_t>(rows), 0);
+  const auto grid_row = [&](int gy) {
+    float* samples = grid_depth_.ptr<float>(gy);
+    if (!row_sampled_[gy]) {
+      row_sampled_[gy] = 1;
+      const float* pixels = depth.ptr<float>(std::min(gy * s + s / 2, depth.rows - 1));
+      for (int gx = 0; gx < cols; ++gx)
+        samples[gx] = pixels[std::min(gx * s + s / 2, depth.cols - 1)];
+    }
+    return samples;
   };
   const size_t cells = static_cast<size_t>(rows) * cols;
   region_of_.assign(cells, -1);
@@ -91,7 +92,6 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     }
   }
 
-  constexpr int kOffsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   region_seeds_.clear();
   // Bounding box of all grown cells: the full-resolution fill only visits it.
   int min_x = cols, max_x = -1, min_y = rows, max_y = -1;
@@ -106,10 +106,10 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     int sx = -1, sy = -1;
     float best = std::numeric_limits<float>::infinity();
     for (int y = std::max(0, cy - 1); y <= std::min(rows - 1, cy + 1); ++y) {
+      const float* samples = grid_row(y);
       for (int x = std::max(0, cx - 1); x <= std::min(cols - 1, cx + 1); ++x) {
-        const float sampled = sample(x, y);
-        const float gap = std::abs(sampled - wanted);
-        if (sampled > 0.0f && gap < best) {
+        const float gap = std::abs(samples[x] - wanted);
+        if (samples[x] > 0.0f && gap < best) {
           best = gap;
           sx = x;
           sy = y;
@@ -130,35 +130,39 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     const int region_id = static_cast<int>(region_seeds_.size());
     region_seeds_.push_back(1);
     region_of_[start] = region_id;
-    queue_.assign(1, static_cast<int>(start));
+    // Queue entries are (x, y) pairs, so popping a cell needs no division by the grid width.
+    queue_.assign(1, {sx, sy});
     min_x = std::min(min_x, sx);
     max_x = std::max(max_x, sx);
     min_y = std::min(min_y, sy);
     max_y = std::max(max_y, sy);
     size_t head = 0;
+    // Breadth-first over the 4-neighbourhood. A neighbour joins when it is inside the seed's disc,
+    // unclaimed, valid, continuous with this cell and near the seed's depth.
+    const auto visit = [&](int nx, int ny, float d, double step) {
+      const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
+      if (dx * dx + dy * dy > radius2) return;
+      const size_t next = static_cast<size_t>(ny) * cols + nx;
+      if (region_of_[next] >= 0 || (barriers && barrier_[next])) return;
+      const float nd = grid_row(ny)[nx];
+      if (!(nd > 0.0f) || std::abs(nd - d) > step ||
+          std::abs(nd - seed_depth) > params_.max_depth_from_seed_m)
+        return;
+      region_of_[next] = region_id;
+      queue_.push_back({nx, ny});
+      min_x = std::min(min_x, nx);
+      max_x = std::max(max_x, nx);
+      min_y = std::min(min_y, ny);
+      max_y = std::max(max_y, ny);
+    };
     while (head < queue_.size() && static_cast<int>(queue_.size()) < params_.max_region_samples) {
-      const int cell = queue_[head++];
-      const int x = cell % cols, y = cell / cols;
+      const auto [x, y] = queue_[head++];
       const float d = grid_depth_.ptr<float>(y)[x];  // sampled when the cell joined
       const double step = params_.max_step_abs_m + params_.max_step_relative * d;
-      for (const auto& offset : kOffsets) {
-        const int nx = x + offset[0], ny = y + offset[1];
-        if (nx < 0 || ny < 0 || nx >= cols || ny >= rows) continue;
-        const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
-        if (dx * dx + dy * dy > radius2) continue;
-        const size_t next = static_cast<size_t>(ny) * cols + nx;
-        if (region_of_[next] >= 0 || (barriers && barrier_[next])) continue;
-        const float nd = sample(nx, ny);
-        if (!(nd > 0.0f) || std::abs(nd - d) > step ||
-            std::abs(nd - seed_depth) > params_.max_depth_from_seed_m)
-          continue;
-        region_of_[next] = region_id;
-        queue_.push_back(static_cast<int>(next));
-        min_x = std::min(min_x, nx);
-        max_x = std::max(max_x, nx);
-        min_y = std::min(min_y, ny);
-        max_y = std::max(max_y, ny);
-      }
+      if (x + 1 < cols) visit(x + 1, y, d, step);
+      if (x > 0) visit(x - 1, y, d, step);
+      if (y + 1 < rows) visit(x, y + 1, d, step);
+      if (y > 0) visit(x, y - 1, d, step);
     }
   }
   if (max_x < 0) return;

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace pspslam {
@@ -64,13 +65,14 @@ class DynamicRegionGrower {
  private:
   RegionGrowParams params_;
   float focal_length_px_ = 0.0f;
-  cv::Mat grid_depth_;             // CV_32F, one sample per block, read on first use
-  std::vector<int> region_of_;     // -1 = not visited; otherwise seed region id
-  std::vector<int> region_seeds_;  // dynamic seeds that fell inside each region
+  cv::Mat grid_depth_;                     // CV_32F, one sample per block, read a row at a time
+  std::vector<std::uint8_t> row_sampled_;  // per grid row: grid_depth_ holds its samples
+  std::vector<int> region_of_;             // -1 = not visited; otherwise seed region id
+  std::vector<int> region_seeds_;          // dynamic seeds that fell inside each region
   std::vector<std::uint8_t> barrier_;
-  std::vector<int> queue_;
-  std::vector<float> fill_sample_;  // per pixel column: its block's sample (NaN: not grown)
-  std::vector<float> fill_step_;    // per pixel column: its block's continuity step
+  std::vector<std::pair<int, int>> queue_;  // grid (x, y) of cells to expand
+  std::vector<float> fill_sample_;          // per pixel column: its block's sample (NaN: not grown)
+  std::vector<float> fill_step_;            // per pixel column: its block's continuity step
 };
 
 }  // namespace pspslam

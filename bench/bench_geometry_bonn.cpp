@@ -13,7 +13,11 @@
 // picks 5 by coverage (reference_selection.h). Much faster than the PnP harness.
 //
 //   bench_geometry_bonn [--frames N] [--shared DIR] [--poses FILE] [--pool-size N] [--repeats N]
-//                       [--node-spacing PX] [--dump FILE]
+//                       [--node-spacing PX] [--dump FILE] [--system-inputs 0|1]
+//   --system-inputs 1 (default): the stage gets what System gives it: the previous -> current
+//   homography computed beforehand (System's flow step) and no keypoint depths (read lazily by
+//   the stage, only for the points it needs); the stage time is then System's geometry step.
+//   0: the stage gets the ORB matches (estimates H itself, "module" time) and the depths.
 //   --dump FILE: per-frame CSV of the last pass (CPU ms per part and counts of both strategies).
 #include <algorithm>
 #include <cstdio>
@@ -88,6 +92,7 @@ int main(int argc, char** argv) {
   fs::path shared = shared_dir();
   fs::path poses_file;
   fs::path dump_file;
+  bool system_inputs = true;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--frames") max_frames = std::stoi(argv[i + 1]);
@@ -97,6 +102,7 @@ int main(int argc, char** argv) {
     if (key == "--repeats") repeats = std::stoi(argv[i + 1]);
     if (key == "--node-spacing") node_spacing = std::stof(argv[i + 1]);
     if (key == "--dump") dump_file = argv[i + 1];
+    if (key == "--system-inputs") system_inputs = std::stoi(argv[i + 1]) != 0;
   }
   Trajectory poses;
   if (!poses_file.empty()) poses = read_tum_trajectory(poses_file);
@@ -216,6 +222,7 @@ int main(int argc, char** argv) {
     Pose T_world_current = Pose::Identity();
     std::vector<DepthView> references;
     std::vector<Eigen::Vector2d> x, y;
+    std::optional<Eigen::Matrix3d> H_previous_to_current;  // --system-inputs: from the matches
   };
   std::vector<StageFrame> stage_frames;
   for (size_t i = 50; i < frames.size(); ++i) {
@@ -267,7 +274,13 @@ int main(int argc, char** argv) {
       x.push_back(frames[i - 1].keypoints[d.queryIdx]);
       y.push_back(frames[i].keypoints[d.trainIdx]);
     }
-    stage_frames.push_back({i, T_world_current, std::move(references), std::move(x), std::move(y)});
+    std::optional<Eigen::Matrix3d> H;
+    if (system_inputs && x.size() >= 4) {
+      const CompensatedHomography h = estimate_compensated_homography(x, y, HomographyParams{});
+      if (h.valid) H = h.H;
+    }
+    stage_frames.push_back(
+        {i, T_world_current, std::move(references), std::move(x), std::move(y), H});
   }
   // Each pass runs both strategies on every frame with fresh stages; the strategy that runs
   // first on a frame finds the reference depth images out of cache, so the order alternates
@@ -324,10 +337,14 @@ int main(int argc, char** argv) {
       input.depth = frames[i].depth;
       input.T_world_camera = sf.T_world_current;
       input.keypoints = frames[i].keypoints;
-      input.keypoint_depths = frames[i].depths;
+      if (!system_inputs) input.keypoint_depths = frames[i].depths;
       input.references = sf.references;
-      input.matched_previous = sf.x;
-      input.matched_current = sf.y;
+      if (system_inputs) {
+        input.H_previous_to_current = sf.H_previous_to_current;
+      } else {
+        input.matched_previous = sf.x;
+        input.matched_current = sf.y;
+      }
       input.previous_dynamic_mask = previous_mask;
       GeometryFrameResult e, a;
       if ((k + static_cast<size_t>(pass)) % 2 == 0) {
@@ -406,6 +423,10 @@ int main(int argc, char** argv) {
   else
     std::printf("\ngeometry stage over %zu frames (poses %s, 5 of a pool of %d frames 5 apart):\n",
                 ant_cpu.size(), poses_file.c_str(), pool_size);
+  std::printf(system_inputs
+                  ? "  inputs as System gives them: H from its flow step, keypoint depths read by "
+                    "the stage (module = System's geometry step)\n"
+                  : "  inputs: ORB matches (the stage estimates H) and keypoint depths\n");
   std::printf("  %-11s module cpu median %.3f ms (wall %.3f ms), search cpu median %.3f ms\n",
               "ant_colony", median(ant_cpu), median(ant_wall), median(ant_search));
   std::printf("  %-11s module cpu median %.3f ms (wall %.3f ms), search cpu median %.3f ms\n",

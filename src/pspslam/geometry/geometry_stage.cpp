@@ -139,11 +139,13 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
     candidates_[i] = {pixel, kDepthNotRead};
     if (use_prior) {
       // Where was this pixel in the previous frame? (inverse of the compensating homography)
-      const Eigen::Vector2d previous_pixel = transfer_point(current_to_previous, pixel);
-      const int u = static_cast<int>(std::floor(previous_pixel.x()));
-      const int v = static_cast<int>(std::floor(previous_pixel.y()));
-      if (u >= 0 && v >= 0 && u < previous_mask.cols && v < previous_mask.rows &&
-          previous_mask.at<std::uint8_t>(v, u))
+      // Bounds checked on the doubles: inside the image, truncation is the floor (std::floor is
+      // a libm call without SSE4.1).
+      const Eigen::Vector2d previous = transfer_point(current_to_previous, pixel);
+      if (previous.x() >= 0.0 && previous.y() >= 0.0 && previous.x() < previous_mask.cols &&
+          previous.y() < previous_mask.rows &&
+          previous_mask.ptr<std::uint8_t>(
+              static_cast<int>(previous.y()))[static_cast<int>(previous.x())])
         priority_.push_back(static_cast<int>(i));
     }
   }

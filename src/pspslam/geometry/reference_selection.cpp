@@ -52,9 +52,12 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
   // Back-project the sampled candidates once; each view then only transforms and projects.
   const size_t stride = static_cast<size_t>(std::max(1, params_.point_stride));
   sampled_.clear();
+  sampled_norms_.clear();
   for (size_t i = 0; i < points.size(); i += stride) {
-    if (points[i].depth > 0.0)
+    if (points[i].depth > 0.0) {
       sampled_.push_back(camera_.unproject(points[i].pixel, points[i].depth));
+      sampled_norms_.push_back(sampled_.back().norm());
+    }
   }
   const size_t sampled = sampled_.size();
   seen_.assign(static_cast<size_t>(views) * sampled, 0);
@@ -85,7 +88,7 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
                                    kBlock)[static_cast<int>(pixel.x()) / kBlock])
         continue;
       const Eigen::Vector3d ray = p - centre;
-      if (p.dot(ray) < cos_max_parallax * p.norm() * ray.norm()) continue;
+      if (p.dot(ray) < cos_max_parallax * sampled_norms_[s] * ray.norm()) continue;
       seen[s] = 1;
     }
   }

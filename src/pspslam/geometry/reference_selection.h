@@ -57,6 +57,7 @@ class ReferenceSelector {
   Params params_;
   std::vector<CachedView> cache_;
   std::vector<Eigen::Vector3d> sampled_;  // back-projected sampled candidates
+  std::vector<double> sampled_norms_;     // their distances from the camera (parallax test)
   std::vector<std::uint8_t> seen_;        // pool view x sampled point
   std::vector<int> coverage_;             // picks that see each sampled point
   std::vector<std::uint8_t> picked_;

@@ -15,7 +15,12 @@ constexpr int kBlock = 8;
 ReferenceSelector::ReferenceSelector(PinholeCamera camera, Params params)
     : camera_(camera), params_(params) {}
 
-const cv::Mat& ReferenceSelector::validity(const cv::Mat& depth) {
+bool ReferenceSelector::BlockValidity::at_pixel(int x, int y) const {
+  const int block = (y / kBlock) * blocks_per_row + x / kBlock;
+  return (bits[static_cast<size_t>(block) >> 6] >> (block & 63)) & 1u;
+}
+
+const ReferenceSelector::BlockValidity& ReferenceSelector::validity(const cv::Mat& depth) {
   for (CachedView& view : cache_) {
     if (view.depth.data == depth.data && view.depth.size() == depth.size()) {
       view.used = true;
@@ -25,15 +30,18 @@ const cv::Mat& ReferenceSelector::validity(const cv::Mat& depth) {
   // A keyframe stays in the pool for many frames: its map is built once. The cache holds a
   // shallow copy of the depth image, so the buffer (and thus its address) cannot be reused
   // while the entry exists.
-  CachedView view{
-      depth,
-      cv::Mat((depth.rows + kBlock - 1) / kBlock, (depth.cols + kBlock - 1) / kBlock, CV_8UC1),
-      true};
-  for (int by = 0; by < view.valid.rows; ++by) {
+  CachedView view{depth, {}, true};
+  const int block_rows = (depth.rows + kBlock - 1) / kBlock;
+  view.valid.blocks_per_row = (depth.cols + kBlock - 1) / kBlock;
+  view.valid.bits.assign((static_cast<size_t>(block_rows) * view.valid.blocks_per_row + 63) / 64,
+                         0);
+  for (int by = 0; by < block_rows; ++by) {
     const float* row = depth.ptr<float>(std::min(by * kBlock + kBlock / 2, depth.rows - 1));
-    std::uint8_t* out = view.valid.ptr<std::uint8_t>(by);
-    for (int bx = 0; bx < view.valid.cols; ++bx)
-      out[bx] = row[std::min(bx * kBlock + kBlock / 2, depth.cols - 1)] > 0.0f;
+    for (int bx = 0; bx < view.valid.blocks_per_row; ++bx) {
+      const size_t block = static_cast<size_t>(by) * view.valid.blocks_per_row + bx;
+      if (row[std::min(bx * kBlock + kBlock / 2, depth.cols - 1)] > 0.0f)
+        view.valid.bits[block >> 6] |= std::uint64_t{1} << (block & 63);
+    }
   }
   cache_.push_back(std::move(view));
   return cache_.back().valid;
@@ -69,7 +77,7 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
     if (depth.empty()) continue;
     // A view without a depth reading there (beyond the sensor's range, a hole) cannot test the
     // point: leaving this check out cost 0.14 of the test's recall (docs/geometry.md).
-    const cv::Mat& valid = validity(depth);
+    const BlockValidity& valid = validity(depth);
     const Pose T_ref_current = pool[v].T_world_camera.inverse() * T_world_current;
     const Eigen::Matrix3d R = T_ref_current.linear();
     const Eigen::Vector3d t = T_ref_current.translation();
@@ -84,9 +92,7 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
       if (!(pixel.x() >= border && pixel.y() >= border && pixel.x() < depth.cols - border &&
             pixel.y() < depth.rows - border))
         continue;
-      if (!valid.ptr<std::uint8_t>(static_cast<int>(pixel.y()) /
-                                   kBlock)[static_cast<int>(pixel.x()) / kBlock])
-        continue;
+      if (!valid.at_pixel(static_cast<int>(pixel.x()), static_cast<int>(pixel.y()))) continue;
       const Eigen::Vector3d ray = p - centre;
       if (p.dot(ray) < cos_max_parallax * sampled_norms_[s] * ray.norm()) continue;
       seen[s] = 1;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -46,12 +47,19 @@ class ReferenceSelector {
  private:
   // Per pool view, one validity bit per 8x8 block of its depth image, built the first time the
   // view is seen (a look-up in ~20 full-size depth images per frame was mostly cache misses).
+  // Packed bits: a pool's maps take a few kB, so the per-frame look-ups hit L1 instead of
+  // missing in byte maps 8 times larger (the look-up was a third of the selection's time).
+  struct BlockValidity {
+    int blocks_per_row = 0;
+    std::vector<std::uint64_t> bits;  // bit by * blocks_per_row + bx: the block's centre is valid
+    bool at_pixel(int x, int y) const;
+  };
   struct CachedView {
     cv::Mat depth;  // shallow: keeps the buffer, and so the address used as key, alive
-    cv::Mat valid;  // CV_8UC1, 1 = the block's centre pixel has a reading
+    BlockValidity valid;
     bool used = false;
   };
-  const cv::Mat& validity(const cv::Mat& depth);
+  const BlockValidity& validity(const cv::Mat& depth);
 
   PinholeCamera camera_;
   Params params_;

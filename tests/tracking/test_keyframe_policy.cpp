@@ -10,7 +10,7 @@ KeyFrameEvidence steady_tracking() {
   e.frame_id = 100;
   e.last_keyframe_frame_id = 95;
   e.keyframes_in_map = 10;
-  e.tracked_inliers = 400;
+  e.tracked_inliers = 420;  // 0.93 of the reference
   e.reference_tracked_points = 450;
   e.tracked_close_points = 300;
   e.untracked_close_points = 50;
@@ -23,7 +23,7 @@ TEST(KeyFramePolicy, NoKeyFrameWhileTrackingTheReferenceWell) {
 
 TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   KeyFrameEvidence e = steady_tracking();
-  e.tracked_inliers = 300;  // < 0.85 * 450, mapper idle
+  e.tracked_inliers = 300;  // < 0.9 * 450, mapper idle
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
   e.mapper_idle = false;
   e.last_keyframe_frame_id = 99;
@@ -36,8 +36,9 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
 
 TEST(KeyFramePolicy, TrackedRatioToReferenceIsTheThreshold) {
   KeyFrameEvidence e = steady_tracking();
-  e.tracked_inliers = 370;  // 0.82 of the reference's 450 points
+  e.tracked_inliers = 400;  // 0.89 of the reference's 450 points
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  e.tracked_inliers = 370;  // 0.82
   KeyFramePolicyOptions orb_slam2;
   orb_slam2.tracked_ratio_to_reference = 0.75;
   EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kSkip);

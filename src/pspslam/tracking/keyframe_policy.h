@@ -12,10 +12,10 @@ struct KeyFramePolicyOptions {
   int close_tracked_limit = 100;  // fewer tracked close points than this ...
   int close_untracked_min = 70;   // ... and more untracked close ones: need a keyframe
   // A keyframe is wanted when the frame tracks fewer than this share of the reference keyframe's
-  // points (ORB-SLAM2: 0.75 for RGB-D). 0.85 roughly doubles the keyframes of a slow hand-held
-  // camera and lowers the ATE: synthetic static 600 frames 4.2 -> 3.3 mm, bonn_crowd_dev `full`
-  // 20.7 -> 16.2 mm (docs/benchmarks.md, SLAM core), at more local BA time.
-  double tracked_ratio_to_reference = 0.85;
+  // points (ORB-SLAM2: 0.75 for RGB-D). Denser keyframes lower the ATE of a slow hand-held camera
+  // at more local BA time: bonn_crowd_dev `full` 0.75 / 0.85 / 0.9 / 0.95 -> 22.0 / 18.7 / 16.6 /
+  // 16.8 mm, synthetic static 600 frames 4.2 / 3.3 / 3.2 mm (docs/benchmarks.md, SLAM core).
+  double tracked_ratio_to_reference = 0.9;
   double tracked_ratio_to_reference_first_keyframes = 0.4;  // while the map has < 2 keyframes
 };
 

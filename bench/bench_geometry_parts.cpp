@@ -141,7 +141,8 @@ void BM_RegionGrowing(benchmark::State& state) {
   }
   RegionGrowParams params;
   params.stride = static_cast<int>(state.range(0));
-  DynamicRegionGrower grower(params);
+  // The focal length enables the metric growth radius, as in GeometryStage.
+  DynamicRegionGrower grower(params, static_cast<float>(f.camera.fx));
   cv::Mat mask;
   for (auto _ : state) grower.grow(f.depth, seeds, depths, statics, mask);
   state.counters["seeds"] = static_cast<double>(seeds.size());

@@ -79,7 +79,17 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     return samples;
   };
   const size_t cells = static_cast<size_t>(rows) * cols;
-  region_of_.assign(cells, -1);
+  // Only the cells the last call claimed (its bounding box) need clearing; a full clear wrote the
+  // whole grid every frame.
+  if (region_of_.size() != cells || claimed_cols_ != cols) {
+    region_of_.assign(cells, -1);
+    claimed_cols_ = cols;
+  } else {
+    for (int gy = claimed_.y; gy < claimed_.y + claimed_.height; ++gy)
+      std::fill_n(region_of_.begin() + static_cast<long>(gy) * cols + claimed_.x, claimed_.width,
+                  -1);
+  }
+  claimed_ = {};
   const bool barriers = params_.static_barrier_radius_px > 0.0f;
   barrier_.assign(barriers ? cells : 0, 0);
   if (barriers) {
@@ -140,10 +150,11 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     // Breadth-first over the 4-neighbourhood. A neighbour joins when it is inside the seed's disc,
     // unclaimed, valid, continuous with this cell and near the seed's depth.
     const auto visit = [&](int nx, int ny, float d, double step) {
-      const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
-      if (dx * dx + dy * dy > radius2) return;
+      // Claimed first: inside a region most neighbours already are.
       const size_t next = static_cast<size_t>(ny) * cols + nx;
       if (region_of_[next] >= 0 || (barriers && barrier_[next])) return;
+      const float dx = static_cast<float>(nx - sx), dy = static_cast<float>(ny - sy);
+      if (dx * dx + dy * dy > radius2) return;
       const float nd = grid_row(ny)[nx];
       if (!(nd > 0.0f) || std::abs(nd - d) > step ||
           std::abs(nd - seed_depth) > params_.max_depth_from_seed_m)
@@ -166,42 +177,35 @@ void DynamicRegionGrower::grow(const cv::Mat& depth, std::span<const Eigen::Vect
     }
   }
   if (max_x < 0) return;
-  // Regions that too few seeds support are dropped before painting.
-  for (int gy = min_y; gy <= max_y; ++gy) {
-    int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
-    for (int gx = min_x; gx <= max_x; ++gx) {
-      if (regions[gx] >= 0 && region_seeds_[regions[gx]] < params_.min_seeds_per_region)
-        regions[gx] = -1;
-    }
-  }
+  claimed_ = cv::Rect(min_x, min_y, max_x - min_x + 1, max_y - min_y + 1);
   // Full-resolution fill: a pixel of a grown block joins only if its own depth is continuous with
   // the block's sample, so silhouettes stay pixel-sharp although growth ran on the coarse grid.
-  // Per grid row, each pixel column gets its block's sample and step (NaN sample outside grown
-  // blocks: never continuous), so the s pixel rows below are one branch-free loop each over the
-  // row's run of grown blocks, which the compiler vectorises (a loop per 4x4 block did not).
+  // Regions that too few seeds support are not painted. Per grid row, each pixel column gets its
+  // block's sample and step (NaN sample outside painted blocks: never continuous), so the s pixel
+  // rows below are one branch-free loop each over the row's run of painted blocks, which the
+  // compiler vectorises (a loop per 4x4 block did not).
   const float step_abs = static_cast<float>(params_.max_step_abs_m);
   const float step_relative = static_cast<float>(params_.max_step_relative);
+  const float not_painted = std::numeric_limits<float>::quiet_NaN();
   fill_sample_.resize(static_cast<size_t>(depth.cols));
   fill_step_.resize(static_cast<size_t>(depth.cols));
+  const auto painted = [&](int region) {
+    return region >= 0 && region_seeds_[region] >= params_.min_seeds_per_region;
+  };
   for (int gy = min_y; gy <= max_y; ++gy) {
     const int* regions = region_of_.data() + static_cast<size_t>(gy) * cols;
-    int first = max_x + 1, last = min_x - 1;
-    for (int gx = min_x; gx <= max_x; ++gx) {
-      if (regions[gx] < 0) continue;
-      first = std::min(first, gx);
-      last = gx;
-    }
-    if (first > last) continue;
+    int first = min_x;
+    while (first <= max_x && !painted(regions[first])) ++first;
+    if (first > max_x) continue;
+    int last = max_x;
+    while (!painted(regions[last])) --last;
     const float* samples = grid_depth_.ptr<float>(gy);
     const int x0 = first * s, x1 = std::min(depth.cols, (last + 1) * s);
     for (int gx = first; gx <= last; ++gx) {
-      const bool grown = regions[gx] >= 0;
-      const float value = grown ? samples[gx] : std::numeric_limits<float>::quiet_NaN();
-      const float step = step_abs + step_relative * value;
-      for (int x = gx * s; x < std::min(x1, (gx + 1) * s); ++x) {
-        fill_sample_[x] = value;
-        fill_step_[x] = step;
-      }
+      const float value = painted(regions[gx]) ? samples[gx] : not_painted;
+      const int begin = gx * s, count = std::min(x1, begin + s) - begin;
+      std::fill_n(fill_sample_.begin() + begin, count, value);
+      std::fill_n(fill_step_.begin() + begin, count, step_abs + step_relative * value);
     }
     const float* block_samples = fill_sample_.data();
     const float* block_steps = fill_step_.data();

@@ -68,6 +68,8 @@ class DynamicRegionGrower {
   cv::Mat grid_depth_;                     // CV_32F, one sample per block, read a row at a time
   std::vector<std::uint8_t> row_sampled_;  // per grid row: grid_depth_ holds its samples
   std::vector<int> region_of_;             // -1 = not visited; otherwise seed region id
+  cv::Rect claimed_;                       // grid cells the last call may have claimed
+  int claimed_cols_ = 0;                   // grid width region_of_ was laid out for
   std::vector<int> region_seeds_;          // dynamic seeds that fell inside each region
   std::vector<std::uint8_t> barrier_;
   std::vector<std::pair<int, int>> queue_;  // grid (x, y) of cells to expand

@@ -56,6 +56,9 @@ def collect(work):
             "ate_refined_rmse": (stats.get("ate_refined") or {}).get("rmse"),
             "rpe_trans_rmse_m": ev.get("rpe", {}).get("translation_m", {}).get("rmse"),
             "rpe_rot_rmse_deg": ev.get("rpe", {}).get("rotation_deg", {}).get("rmse"),
+            # pspslam eval: the ground truth tracks another body than the camera -> RPE meaningless
+            "rpe_body_frames_differ": ev.get("rpe", {}).get("body_frames_differ", False),
+            "rpe_body_frame_rotation_deg": ev.get("rpe", {}).get("body_frame_rotation_deg"),
             "timing_median_ms": {k: v.get("median") for k, v in timing.items() if v.get("count")},
             "dynamic": stats.get("dynamic"), "mask_latency": stats.get("mask_latency"),
             "dir": str(run_dir)})
@@ -113,6 +116,7 @@ def main():
                 "ate_rmse_m": summary([r["ate_rmse"] for r in group]),
                 "ate_refined_rmse_m": summary([r["ate_refined_rmse"] for r in group]),
                 "rpe_trans_rmse_m": summary([r["rpe_trans_rmse_m"] for r in group]),
+                "rpe_body_frames_differ": any(r["rpe_body_frames_differ"] for r in group),
                 "fps": summary([r["fps"] for r in group]),
                 "lost_frames": summary([r["lost_frames"] for r in group]),
                 "timing_median_ms": timings,
@@ -144,10 +148,21 @@ def main():
     for key, row in table.items():
         ate = row["ate_rmse_m"] or {}
         refined = row["ate_refined_rmse_m"] or {}
+        rpe = ("n/a (a)" if row["rpe_body_frames_differ"]
+               else fmt((row['rpe_trans_rmse_m'] or {}).get('median')))
         md.append(f"| {row['sequence']} | {row['mode']} | {row['runs']} | {fmt(ate.get('median'))} | "
                   f"{fmt(ate.get('mean'))} | {fmt(ate.get('min'))} | {fmt(ate.get('max'))} | "
-                  f"{fmt(refined.get('median'))} | {fmt((row['rpe_trans_rmse_m'] or {}).get('median'))} | "
+                  f"{fmt(refined.get('median'))} | {rpe} | "
                   f"{fmt((row['fps'] or {}).get('median'), 1)} |")
+    differ = sorted({(r["sequence"], round(r["rpe_body_frame_rotation_deg"]))
+                     for r in runs if r["rpe_body_frames_differ"]})
+    if differ:
+        seqs = sorted({seq for seq, _ in differ})
+        angles = sorted({angle for _, angle in differ})
+        md += ["", f"(a) {', '.join(seqs)}: `pspslam eval` finds the ground truth's body frame "
+               f"rotated {'/'.join(str(a) for a in angles)} deg from the camera's (it tracks the "
+               "motion-capture markers), so RPE compares motions in different frames; the ATE "
+               "(positions only) is valid."]
     missing = [f"{s}/{m}" for s in sequences for m in MODES if f"{s}/{m}" not in table]
     if missing:
         md += ["", "Not run (no time): " + ", ".join(missing)]

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "pspslam/core/error.h"
+#include "pspslam/eval/report.h"
 #include "pspslam/eval/rpe.h"
 
 namespace pspslam {
@@ -66,6 +67,65 @@ TEST(Rpe, IdenticalTrajectoriesHaveZeroError) {
   const RpeResult rpe = compute_rpe(gt, gt);
   EXPECT_LT(rpe.translation.max, 1e-12);
   EXPECT_LT(rpe.rotation.max, 1e-5);  // acos near 1 amplifies rounding: ~1e-6 deg
+}
+
+// A hand-held camera: yaw, pitch and roll all vary, so relative rotations turn about many axes.
+Trajectory hand_held_trajectory() {
+  Trajectory trajectory;
+  for (int i = 0; i < kPoses; ++i) {
+    const double t = i / kRate;
+    const double deg = std::numbers::pi / 180.0;
+    StampedPose p;
+    p.timestamp = 50.0 + t;
+    p.T_world_camera.linear() =
+        (Eigen::AngleAxisd(20.0 * t * deg, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(10.0 * std::sin(t) * deg, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(8.0 * std::cos(1.3 * t) * deg, Eigen::Vector3d::UnitY()))
+            .toRotationMatrix();
+    p.T_world_camera.translation() = Eigen::Vector3d(0.3 * t, 0.1 * std::sin(t), 0.0);
+    trajectory.push_back(p);
+  }
+  return trajectory;
+}
+
+TEST(Rpe, BodyFrameRotationIsZeroForTheSameBody) {
+  const Trajectory camera = hand_held_trajectory();
+  const RpeResult rpe = compute_rpe(camera, camera);
+  EXPECT_LT(rpe.body_frame_rotation_deg, 0.1);
+  EXPECT_FALSE(rpe.body_frames_differ());
+}
+
+TEST(Rpe, GroundTruthOfAnotherBodyIsDetectedAndReported) {
+  // The ground truth tracks a marker body turned 120 deg from the camera (as bonn_crowd_dev's
+  // motion capture: 171 deg): same positions, so the ATE would be 0, but RPE compares motions
+  // expressed in different frames.
+  const Trajectory camera = hand_held_trajectory();
+  const Eigen::Matrix3d camera_to_marker =
+      Eigen::AngleAxisd(120.0 * std::numbers::pi / 180.0, Eigen::Vector3d(1, 2, 3).normalized())
+          .toRotationMatrix();
+  Trajectory marker = camera;
+  for (StampedPose& p : marker) p.T_world_camera.linear() *= camera_to_marker;
+  const RpeResult rpe = compute_rpe(marker, camera);
+  EXPECT_NEAR(rpe.body_frame_rotation_deg, 120.0, 0.5);
+  EXPECT_TRUE(rpe.body_frames_differ());
+  EXPECT_GT(rpe.translation.rmse, 0.1);  // meaningless: the same positions give 0.1+ m "error"
+  const EvalSettings settings;
+  EXPECT_NE(format_eval_table(settings, compute_ate(marker, camera), rpe)
+                .find("warning: the ground truth's body frame is rotated 120 deg"),
+            std::string::npos);
+  EXPECT_NE(format_eval_json(settings, compute_ate(marker, camera), rpe)
+                .find("\"body_frames_differ\": true"),
+            std::string::npos);
+}
+
+TEST(Rpe, BodyFrameRotationIsUndeterminedForTurnsAboutOneAxis) {
+  const Trajectory yaw_only = make_trajectory(0.7, 12.0);
+  const RpeResult rpe = compute_rpe(yaw_only, yaw_only);
+  EXPECT_TRUE(std::isnan(rpe.body_frame_rotation_deg));
+  EXPECT_FALSE(rpe.body_frames_differ());
+  EXPECT_NE(format_eval_json({}, compute_ate(yaw_only, yaw_only), rpe)
+                .find("\"body_frame_rotation_deg\": null"),
+            std::string::npos);
 }
 
 TEST(Rpe, TooShortOrDisjointTrajectoriesAreErrors) {

@@ -83,6 +83,14 @@ std::string format_eval_table(const EvalSettings& settings, const AteResult& ate
   out << table_row("RPE translation rate", "m/s", rpe.translation_per_second, 4);
   out << table_row("RPE rotation", "deg", rpe.rotation, 3);
   out << table_row("RPE rotation rate", "deg/s", rpe.rotation_per_second, 3);
+  if (rpe.body_frames_differ()) {
+    out << "\nwarning: the ground truth's body frame is rotated "
+        << fixed(rpe.body_frame_rotation_deg, 0)
+        << " deg from the estimate's\n"
+           "         (from the pairs' relative rotations): it tracks another body than the camera\n"
+           "         (e.g. motion-capture markers), so the RPE rows compare motions expressed in\n"
+           "         different frames and mean nothing; the ATE (positions only) is valid.\n";
+  }
   return out.str();
 }
 
@@ -102,7 +110,11 @@ std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
   out << "          \"translation_m\": " << json_stats(rpe.translation) << ",\n";
   out << "          \"translation_m_per_s\": " << json_stats(rpe.translation_per_second) << ",\n";
   out << "          \"rotation_deg\": " << json_stats(rpe.rotation) << ",\n";
-  out << "          \"rotation_deg_per_s\": " << json_stats(rpe.rotation_per_second) << "}\n";
+  out << "          \"rotation_deg_per_s\": " << json_stats(rpe.rotation_per_second) << ",\n";
+  out << "          \"body_frame_rotation_deg\": "
+      << (std::isnan(rpe.body_frame_rotation_deg) ? std::string("null")
+                                                  : json_number(rpe.body_frame_rotation_deg))
+      << ", \"body_frames_differ\": " << (rpe.body_frames_differ() ? "true" : "false") << "}\n";
   out << "}\n";
   return out.str();
 }

@@ -1,5 +1,6 @@
 #include "pspslam/eval/rpe.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -52,6 +53,35 @@ double median(std::vector<double> values) {
   return values.size() % 2 == 1 ? values[half] : 0.5 * (values[half - 1] + values[half]);
 }
 
+// Accumulates (estimate axis, ground-truth axis) pairs of relative rotations and solves for the
+// rotation that maps one set onto the other (Kabsch on the axes, weighted by the angles).
+class BodyFrameRotation {
+ public:
+  void add(const Eigen::Matrix3d& est_rotation, const Eigen::Matrix3d& gt_rotation) {
+    const Eigen::AngleAxisd est(est_rotation), gt(gt_rotation);
+    constexpr double kMinTurn = std::numbers::pi / 180.0;  // below 1 degree the axis is noise
+    if (est.angle() < kMinTurn || gt.angle() < kMinTurn) return;
+    correlation_ += (gt.axis() * gt.angle()) * (est.axis() * est.angle()).transpose();
+    ++turning_pairs_;
+  }
+  double degrees() const {
+    if (turning_pairs_ < 10) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(correlation_,
+                                                Eigen::ComputeFullU | Eigen::ComputeFullV);
+    // Axes about a single direction leave the rotation about it free.
+    if (svd.singularValues()(1) < 0.02 * svd.singularValues()(0))
+      return std::numeric_limits<double>::quiet_NaN();
+    Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+    fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+    const Eigen::Matrix3d rotation = svd.matrixU() * fix * svd.matrixV().transpose();
+    return Eigen::AngleAxisd(rotation).angle() * 180.0 / std::numbers::pi;
+  }
+
+ private:
+  Eigen::Matrix3d correlation_ = Eigen::Matrix3d::Zero();
+  int turning_pairs_ = 0;
+};
+
 }  // namespace
 
 std::string to_string(RpeDeltaUnit unit) { return unit == RpeDeltaUnit::seconds ? "s" : "f"; }
@@ -82,6 +112,7 @@ RpeResult compute_rpe(const Trajectory& ground_truth_in, const Trajectory& estim
   const double gt_max_time_difference = 2.0 * median(gt_intervals);
 
   RpeResult result;
+  BodyFrameRotation body_frames;
   std::vector<double> translation, rotation, translation_rate, rotation_rate;
   for (size_t i = 0; i < est.size(); ++i) {
     const size_t j = find_closest_index(index_est, index_est[i] + options.delta);
@@ -97,6 +128,7 @@ RpeResult compute_rpe(const Trajectory& ground_truth_in, const Trajectory& estim
     const Pose est_motion = est[j].T_world_camera.inverse() * est[i].T_world_camera;
     const Pose gt_motion = gt[g1].T_world_camera.inverse() * gt[g0].T_world_camera;
     const Pose error = est_motion.inverse() * gt_motion;
+    body_frames.add(est_motion.linear(), gt_motion.linear());
     RpePair pair;
     pair.est_from = stamp_est_0;
     pair.est_to = stamp_est_1;
@@ -122,6 +154,7 @@ RpeResult compute_rpe(const Trajectory& ground_truth_in, const Trajectory& estim
                 " apart have ground truth at both ends (need at least 2); is the trajectory "
                 "shorter than the delta, or the wrong ground truth?");
   }
+  result.body_frame_rotation_deg = body_frames.degrees();
   result.translation = compute_error_stats(std::move(translation));
   result.rotation = compute_error_stats(std::move(rotation));
   result.translation_per_second = compute_error_stats(std::move(translation_rate));

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,16 @@ struct RpeResult {
   ErrorStats translation_per_second;  // m/s
   ErrorStats rotation_per_second;     // deg/s
   std::vector<RpePair> pairs;
+  // Rotation between the body frames the two trajectories describe, estimated from the rotation
+  // axes of the pairs' relative motions (a relative rotation of body B = A X is X^-1 R_A X: its
+  // axis is the estimate's axis turned by X^-1). Near 0 when both trajectories are of the camera.
+  // Far from 0 when the ground truth tracks another body, e.g. bonn_crowd_dev's motion-capture
+  // marker set (171 degrees): the per-pair errors then compare motions in different frames, so
+  // RPE means nothing while the ATE (positions only) stays valid. NaN when the turning pairs do
+  // not determine it (fewer than 10 turn by >= 1 degree, or all about one axis).
+  double body_frame_rotation_deg = std::numeric_limits<double>::quiet_NaN();
+  static constexpr double kBodyFramesDifferDeg = 10.0;
+  bool body_frames_differ() const { return body_frame_rotation_deg > kBodyFramesDifferDeg; }
 };
 
 // Relative pose error as TUM's evaluate_rpe.py with --fixed_delta (its result, pair for pair):

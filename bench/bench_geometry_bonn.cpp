@@ -290,7 +290,7 @@ int main(int argc, char** argv) {
   exhaustive_params.search.strategy = SearchStrategy::exhaustive;
   if (node_spacing > 0.0f) ant_params.search.node_spacing_px = node_spacing;
   std::vector<double> ant_cpu, ex_cpu, ant_wall, ex_wall, ant_search, ex_search, tested_share;
-  std::vector<double> ant_no_h, ex_no_h, selection, ant_region, ex_region;
+  std::vector<double> ant_no_h, ex_no_h, selection, ant_region, ex_region, last_band_share;
   std::vector<double> pass_module_ratio, pass_search_ratio, pass_no_h_ratio;
   // The per-frame times are bimodal (static room frames: few dynamic points; crowd frames: half
   // the points on people), so a median can sit between the modes and jump between passes. The
@@ -319,7 +319,7 @@ int main(int argc, char** argv) {
     GeometryStage ant(ideal, ant_params), exhaustive(ideal, exhaustive_params);
     for (std::vector<double>* v :
          {&ant_cpu, &ex_cpu, &ant_wall, &ex_wall, &ant_search, &ex_search, &tested_share, &ant_no_h,
-          &ex_no_h, &selection, &ant_region, &ex_region})
+          &ex_no_h, &selection, &ant_region, &ex_region, &last_band_share})
       v->clear();
     static_flags = static_points = crowd_flags = crowd_points = kept = found = 0;
     cv::Mat previous_mask;
@@ -328,7 +328,7 @@ int main(int argc, char** argv) {
     if (last_pass && !dump_file.empty()) {
       dump.open(dump_file);
       dump << "frame,points,strategy,total,homography,selection,search,region,tested,"
-              "tested_dynamic,dynamic,mask_pixels\n";
+              "tested_dynamic,dynamic,mask_pixels,last_band_tests\n";
     }
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const StageFrame& sf = stage_frames[k];
@@ -363,7 +363,7 @@ int main(int argc, char** argv) {
                << t.total_cpu_ms << ',' << t.homography_cpu_ms << ',' << t.selection_cpu_ms << ','
                << t.search_cpu_ms << ',' << t.region_cpu_ms << ',' << r->tested_count << ','
                << r->tested_dynamic_count << ',' << r->dynamic_count << ','
-               << cv::countNonZero(r->dynamic_mask) << '\n';
+               << cv::countNonZero(r->dynamic_mask) << ',' << r->last_band_tests << '\n';
         }
       }
       ex_cpu.push_back(e.timing.total_cpu_ms);
@@ -379,6 +379,8 @@ int main(int argc, char** argv) {
       ant_search.push_back(a.timing.search_cpu_ms);
       tested_share.push_back(double(a.tested_count) /
                              std::max<size_t>(1, frames[i].keypoints.size()));
+      last_band_share.push_back(double(a.last_band_tests) /
+                                std::max<size_t>(1, frames[i].keypoints.size()));
       for (size_t q = 0; q < frames[i].keypoints.size(); ++q) {
         found += e.keypoint_tested_dynamic[q];
         kept += e.keypoint_tested_dynamic[q] && a.keypoint_tested_dynamic[q];
@@ -444,15 +446,17 @@ int main(int argc, char** argv) {
       median(ant_no_h), median(ex_no_h), median(ant_no_h) / median(ex_no_h), median(selection),
       median(ant_region), median(ex_region));
   {
-    std::vector<double> crowd_tested, static_tested;
+    std::vector<double> crowd_tested, static_tested, crowd_last_band;
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const int index = frame_index[stage_frames[k].index];
       if (index >= 220) crowd_tested.push_back(tested_share[k]);
+      if (index >= 220) crowd_last_band.push_back(last_band_share[k]);
       if (index < 215) static_tested.push_back(tested_share[k]);
     }
     std::printf(
-        "  ant colony tested share (median): static frames <215 %.3f, crowd frames >=220 %.3f\n",
-        median(static_tested), median(crowd_tested));
+        "  ant colony tested share (median): static frames <215 %.3f, crowd frames >=220 %.3f, "
+        "of which in the last (empty) band rounds %.3f\n",
+        median(static_tested), median(crowd_tested), median(crowd_last_band));
   }
   std::printf(
       "  dynamic share of keypoints (ant colony, final flags): static room frames <215 "

@@ -166,6 +166,29 @@ TEST(AntColonySearch, PriorityPointsSeedCommunities) {
   EXPECT_EQ(search.run(points, kImage, is_dynamic, priority).dynamic_count, 10);
 }
 
+TEST(AntColonySearch, CountsTheTestsOfTheLastEmptyBand) {
+  // Ten dynamic points in a row (x 300..318) seeded from a priority point at x = 300. Round 1's
+  // band (dZ = 80 px around x = 300) holds the row; round 2's band around the row's hull reaches
+  // the 4 static points at x = 388 (88 px from the seed, 70 px from the hull) and finds nothing,
+  // so it is the last band and made exactly those 4 tests. Points at x = 500 are never tested.
+  std::vector<Eigen::Vector2f> points;
+  for (int k = 0; k < 10; ++k) points.emplace_back(300.0f + 2.0f * k, 48.0f);
+  for (int k = 0; k < 4; ++k) points.emplace_back(388.0f, 40.0f + 5.0f * k);
+  for (int k = 0; k < 4; ++k) points.emplace_back(500.0f, 40.0f + 5.0f * k);
+  const auto is_dynamic = [](int i) { return i < 10; };
+  AntColonyParams fixed_lanes;
+  fixed_lanes.lane_spacing_px = 48.0f;  // lanes at y = 24, 72, ...: the path misses y = 40..55
+  fixed_lanes.alternate_lanes = false;
+  DynamicPointSearch search(fixed_lanes);
+  const std::vector<int> priority = {0};
+  const SearchResult& result = search.run(points, kImage, is_dynamic, priority);
+  EXPECT_EQ(result.dynamic_count, 10);
+  EXPECT_EQ(result.tested_count, 14);
+  EXPECT_EQ(result.communities, 1);
+  EXPECT_EQ(result.band_rounds, 2);
+  EXPECT_EQ(result.last_band_tests, 4);
+}
+
 TEST(AntColonySearch, AlternateRunsShiftTheLanesByHalfASpacing) {
   // A short cluster exactly between two lanes of phase 0 lies on a lane of phase 1, so a mover
   // the path passes by in one frame is found in the next one.

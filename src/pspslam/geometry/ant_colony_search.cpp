@@ -123,6 +123,7 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
   const float half_cell = cell_size_ / 2.0f;
   for (int round = 0; round < params_.max_band_rounds; ++round) {
     ++result_.band_rounds;
+    const int tested_before = result_.tested_count;
     // The hull of (previous hull vertices + new finds) is the hull of every find so far, so the
     // community is reduced to its hull vertices each round: sorting stays cheap.
     convex_hull(community_, hull_scratch_, hull_);
@@ -212,7 +213,10 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
           test_cell(cell, points, is_dynamic, in_band);
       }
     }
-    if (found_.empty()) return;  // a band without new dynamic points ends this community
+    if (found_.empty()) {  // a band without new dynamic points ends this community
+      result_.last_band_tests += result_.tested_count - tested_before;
+      return;
+    }
     for (int index : found_) community_.push_back(points[index]);
   }
 }
@@ -223,7 +227,8 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   const size_t n = points.size();
   result_.dynamic.assign(n, 0);
   result_.tested.assign(n, 0);
-  result_.tested_count = result_.dynamic_count = result_.communities = result_.band_rounds = 0;
+  result_.tested_count = result_.dynamic_count = result_.communities = result_.band_rounds =
+      result_.last_band_tests = 0;
   if (n == 0) return result_;
 
   if (params_.strategy == SearchStrategy::exhaustive) {

@@ -46,6 +46,9 @@ struct SearchResult {
   int dynamic_count = 0;
   int communities = 0;  // dynamic clusters grown from a path node or a priority point
   int band_rounds = 0;  // hull-band rounds over all communities
+  // Tests made in the band rounds that found nothing (each community's last round): the most a
+  // sparser last band could save.
+  int last_band_tests = 0;
 };
 
 // Index of a candidate point -> is it dynamic (the multi-view test). Called at most once per point.

@@ -206,6 +206,7 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   result.keypoint_dynamic.assign(n, 0);
   result.tested_count = search.tested_count;
   result.tested_dynamic_count = search.dynamic_count;
+  result.last_band_tests = search.last_band_tests;
   for (size_t i = 0; i < n; ++i) {
     const int u = static_cast<int>(points_[i].x()), v = static_cast<int>(points_[i].y());
     const bool in_mask = u >= 0 && v >= 0 && u < result.dynamic_mask.cols &&

@@ -88,6 +88,7 @@ struct GeometryFrameResult {
   int tested_count = 0;
   int references_used = 0;
   int tested_dynamic_count = 0;
+  int last_band_tests = 0;  // SearchResult::last_band_tests
   int dynamic_count = 0;
   CompensatedHomography homography;  // valid = false when no matches were given
   // Previous mask in the motion-compensated frame (only with output_warped_previous_mask).

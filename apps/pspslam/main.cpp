@@ -31,8 +31,7 @@ void print_usage(std::ostream& out) {
   out << "usage: pspslam <command> [flags]   (pspslam <command> --help for its flags)\n\n"
          "commands:\n";
   for (const Command& c : commands()) {
-    out << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary
-        << "\n";
+    out << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
   }
 }
 

@@ -216,10 +216,10 @@ TEST(CliRun, ExportsStaticMapAndDenseCloudAsPly) {
   const Result synth =
       pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 2 --seed 3");
   ASSERT_EQ(synth.status, 0) << synth.output;
-  const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
-                           (dir / "out").string() + " --dynamic geometry --export-map " +
-                           (dir / "map.ply").string() + " --export-dense " +
-                           (dir / "dense.ply").string());
+  const Result r =
+      pspslam("run --sequence " + (dir / "seq").string() + " --out " + (dir / "out").string() +
+              " --dynamic geometry --export-map " + (dir / "map.ply").string() +
+              " --export-dense " + (dir / "dense.ply").string());
   ASSERT_EQ(r.status, 0) << r.output;
   const std::vector<ColoredPoint> map = read_point_cloud_ply(dir / "map.ply");
   const std::vector<ColoredPoint> dense = read_point_cloud_ply(dir / "dense.ply");
@@ -234,8 +234,7 @@ TEST(CliRun, ExportsStaticMapAndDenseCloudAsPly) {
   size_t outside = 0;
   for (const ColoredPoint& point : dense) {
     const Eigen::Vector3d p = T_room_slam * point.position.cast<double>();
-    if (p.x() < -0.1 || p.y() < -0.1 || p.z() < -0.1 || p.x() > 7.1 || p.y() > 6.1 ||
-        p.z() > 2.9)
+    if (p.x() < -0.1 || p.y() < -0.1 || p.z() < -0.1 || p.x() > 7.1 || p.y() > 6.1 || p.z() > 2.9)
       ++outside;
   }
   EXPECT_LT(outside, dense.size() / 200) << outside << " of " << dense.size();

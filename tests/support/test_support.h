@@ -24,13 +24,13 @@ int run_shell(const std::string& command, std::string* output);
 // Use at the top of a test that reads ../shared:
 //   PSPSLAM_SHARED_OR_SKIP(shared);   // declares `std::filesystem::path shared`
 // Skips with the reason when ../shared is missing, fails instead under PSPSLAM_REQUIRE_SHARED=1.
-#define PSPSLAM_SHARED_OR_SKIP(var)                                                         \
+#define PSPSLAM_SHARED_OR_SKIP(var)                                                        \
   const std::filesystem::path var = ::pspslam::testing::shared_dir_if_present();           \
-  if (var.empty()) {                                                                        \
-    if (::pspslam::testing::shared_required()) {                                            \
-      FAIL() << "../shared is required (PSPSLAM_REQUIRE_SHARED=1) but was not found; set "  \
-                "PSPSLAM_SHARED";                                                           \
-    }                                                                                       \
-    GTEST_SKIP() << "../shared not found (set PSPSLAM_SHARED to its path); skipping test "  \
-                    "that needs real data";                                                 \
+  if (var.empty()) {                                                                       \
+    if (::pspslam::testing::shared_required()) {                                           \
+      FAIL() << "../shared is required (PSPSLAM_REQUIRE_SHARED=1) but was not found; set " \
+                "PSPSLAM_SHARED";                                                          \
+    }                                                                                      \
+    GTEST_SKIP() << "../shared not found (set PSPSLAM_SHARED to its path); skipping test " \
+                    "that needs real data";                                                \
   }

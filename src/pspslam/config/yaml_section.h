@@ -49,8 +49,8 @@ class YamlSection {
     try {
       return value.as<T>();
     } catch (const YAML::Exception&) {
-      throw Error(file_ + ":" + std::to_string(value.Mark().line + 1) + ": key '" +
-                  qualified(key) + "' has an invalid value");
+      throw Error(file_ + ":" + std::to_string(value.Mark().line + 1) + ": key '" + qualified(key) +
+                  "' has an invalid value");
     }
   }
 

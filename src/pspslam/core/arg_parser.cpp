@@ -88,11 +88,15 @@ std::string ArgParser::help() const {
     const Spec& s = specs_.at(name);
     std::string left = "  --" + name + (s.takes_value ? " VALUE" : "");
     out << left;
-    if (left.size() < 26) out << std::string(26 - left.size(), ' ');
-    else out << "\n" << std::string(26, ' ');
+    if (left.size() < 26)
+      out << std::string(26 - left.size(), ' ');
+    else
+      out << "\n" << std::string(26, ' ');
     out << s.help;
-    if (s.required) out << " (required)";
-    else if (!s.default_value.empty()) out << " (default: " << s.default_value << ")";
+    if (s.required)
+      out << " (required)";
+    else if (!s.default_value.empty())
+      out << " (default: " << s.default_value << ")";
     if (s.multi) out << " (repeatable)";
     out << "\n";
   }

@@ -111,9 +111,7 @@ std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
   out << "          \"translation_m_per_s\": " << json_stats(rpe.translation_per_second) << ",\n";
   out << "          \"rotation_deg\": " << json_stats(rpe.rotation) << ",\n";
   out << "          \"rotation_deg_per_s\": " << json_stats(rpe.rotation_per_second) << ",\n";
-  out << "          \"body_frame_rotation_deg\": "
-      << (std::isnan(rpe.body_frame_rotation_deg) ? std::string("null")
-                                                  : json_number(rpe.body_frame_rotation_deg))
+  out << "          \"body_frame_rotation_deg\": " << json_number(rpe.body_frame_rotation_deg)
       << ", \"body_frames_differ\": " << (rpe.body_frames_differ() ? "true" : "false") << "}\n";
   out << "}\n";
   return out.str();

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -202,6 +203,12 @@ int run_command(const std::vector<std::string>& args) {
                     "(default: deterministic, each frame waits for its mask and for local "
                     "mapping to finish the previous keyframe)");
   parser.add_option("mask-margin", "dilation of the semantic dynamic mask (pixels)", "5");
+  std::ostringstream default_keyframe_ratio;
+  default_keyframe_ratio << KeyFramePolicyOptions{}.tracked_ratio_to_reference;
+  parser.add_option("keyframe-ratio",
+                    "a frame becomes a keyframe when it tracks fewer than this share of its "
+                    "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)",
+                    default_keyframe_ratio.str());
   parser.add_option("vocabulary",
                     "ORB bag-of-words vocabulary for relocalisation (relative: to the source "
                     "directory)",
@@ -262,6 +269,10 @@ int run_command(const std::vector<std::string>& args) {
   SystemOptions system_options;
   system_options.local_mapping = !parser.flag("no-local-mapping");
   system_options.synchronous_local_mapping = !parser.flag("realtime");
+  double& keyframe_ratio = system_options.tracker.keyframes.tracked_ratio_to_reference;
+  keyframe_ratio = parser.get_double("keyframe-ratio");
+  if (!(keyframe_ratio > 0.0 && keyframe_ratio <= 1.0))
+    throw Error("--keyframe-ratio must be in (0, 1], got " + parser.get("keyframe-ratio"));
   DynamicOptions& dynamic = system_options.dynamic;
   dynamic.model = parser.get("model");
   if (dynamic.model.is_relative()) dynamic.model = source_dir() / dynamic.model;

@@ -208,6 +208,32 @@ TEST(CliRun, BonnCrowdDevSequenceReport) {
   EXPECT_NO_THROW(read_tum_trajectory(out / "trajectory.txt"));
 }
 
+// --keyframe-ratio reaches the keyframe policy: on the same sequence, ORB-SLAM2's sparser 0.5
+// makes fewer keyframes than 0.95; out-of-range values are errors.
+TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
+  const auto dir = testing::make_temp_dir("cli_keyframes");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 60 --bodies 0 --seed 2");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const auto keyframes = [&](const std::string& ratio) {
+    const auto out = dir / ("out" + ratio);
+    const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " + out.string() +
+                             " --dynamic off --keyframe-ratio " + ratio);
+    EXPECT_EQ(r.status, 0) << r.output;
+    return read_tum_trajectory(out / "keyframes.txt").size();
+  };
+  const size_t sparse = keyframes("0.5"), dense = keyframes("0.95");
+  EXPECT_GE(sparse, 1u);
+  EXPECT_GT(dense, sparse);
+  for (const std::string bad : {"0", "1.5"}) {
+    const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                             (dir / "bad").string() + " --keyframe-ratio " + bad);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(contains(r.output, "error: --keyframe-ratio must be in (0, 1], got " + bad))
+        << r.output;
+  }
+}
+
 // --export-map / --export-dense on a rendered room: the map PLY holds exactly the map points
 // the run reports, and the dense cloud, carried into the renderer's world with the first ground
 // truth pose (SLAM's world is the first camera), lies inside the 7 x 6 x 2.8 m room.

@@ -14,7 +14,8 @@ struct KeyFramePolicyOptions {
   // A keyframe is wanted when the frame tracks fewer than this share of the reference keyframe's
   // points (ORB-SLAM2: 0.75 for RGB-D). Denser keyframes lower the ATE of a slow hand-held camera
   // at more local BA time: bonn_crowd_dev `full` 0.75 / 0.85 / 0.9 / 0.95 -> 22.0 / 18.7 / 16.6 /
-  // 16.8 mm, synthetic static 600 frames 4.2 / 3.3 / 3.2 mm (docs/benchmarks.md, SLAM core).
+  // 16.8 mm, synthetic static 600 frames 0.75 / 0.85 / 0.9 -> 4.2 / 3.3 / 3.2 mm
+  // (docs/benchmarks.md, SLAM core; `pspslam run --keyframe-ratio` sets it).
   double tracked_ratio_to_reference = 0.9;
   double tracked_ratio_to_reference_first_keyframes = 0.4;  // while the map has < 2 keyframes
 };

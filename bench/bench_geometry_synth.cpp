@@ -69,6 +69,7 @@ struct Frame {
 
 struct Counts {
   long tp = 0, fp = 0, fn = 0, test_tp = 0, test_fp = 0, test_fn = 0, tested = 0, points = 0;
+  long implied = 0, mask_pixels = 0;
   std::vector<double> cpu_ms, search_cpu_ms, selection_cpu_ms, region_cpu_ms;
   double recall() const { return double(tp) / std::max(1L, tp + fn); }
   double precision() const { return double(tp) / std::max(1L, tp + fp); }
@@ -90,8 +91,10 @@ struct StrategyRun {
   cv::Mat previous_mask;
   Counts c;
 
+  // Appends each keypoint's test verdict to `tested_dynamic` and its final verdict (tested
+  // dynamic or inside the grown mask: what SLAM uses) to `final_dynamic`.
   void step(const Frame& f, std::vector<std::uint8_t>* tested_dynamic,
-            std::vector<std::vector<int>>* priorities) {
+            std::vector<std::uint8_t>* final_dynamic, std::vector<std::vector<int>>* priorities) {
     GeometryFrameInput input;
     input.depth = f.depth;
     input.T_world_camera = f.T_world_camera;
@@ -124,8 +127,11 @@ struct StrategyRun {
       c.test_fp += !truth && test;
       c.test_fn += truth && !test;
       if (tested_dynamic) tested_dynamic->push_back(test);
+      if (final_dynamic) final_dynamic->push_back(flag + 2 * r.keypoint_tested[i] + 4 * truth);
     }
     c.tested += r.tested_count;
+    c.implied += r.implied_count;
+    c.mask_pixels += cv::countNonZero(r.dynamic_mask);
     c.points += long(f.keypoints.size());
     c.cpu_ms.push_back(r.timing.total_cpu_ms);
     c.search_cpu_ms.push_back(r.timing.search_cpu_ms);
@@ -140,16 +146,17 @@ struct StrategyRun {
 void run_both(const GeometryParams& ant, const GeometryParams& exhaustive,
               const PinholeCamera& camera, const std::vector<Frame>& frames, bool first_ant,
               Counts& ca, Counts& ce, std::vector<std::uint8_t>& flags_ant,
-              std::vector<std::uint8_t>& flags_exhaustive,
+              std::vector<std::uint8_t>& flags_exhaustive, std::vector<std::uint8_t>& final_ant,
+              std::vector<std::uint8_t>& final_exhaustive,
               std::vector<std::vector<int>>& priorities) {
   StrategyRun a(ant, camera), e(exhaustive, camera);
   for (size_t k = 0; k < frames.size(); ++k) {
     if ((k % 2 == 0) == first_ant) {
-      a.step(frames[k], &flags_ant, &priorities);
-      e.step(frames[k], &flags_exhaustive, nullptr);
+      a.step(frames[k], &flags_ant, &final_ant, &priorities);
+      e.step(frames[k], &flags_exhaustive, &final_exhaustive, nullptr);
     } else {
-      e.step(frames[k], &flags_exhaustive, nullptr);
-      a.step(frames[k], &flags_ant, &priorities);
+      e.step(frames[k], &flags_exhaustive, &final_exhaustive, nullptr);
+      a.step(frames[k], &flags_ant, &final_ant, &priorities);
     }
   }
   ca = std::move(a.c);
@@ -480,28 +487,59 @@ int main(int argc, char** argv) {
     exhaustive.search.strategy = SearchStrategy::exhaustive;
     std::vector<double> ratios, search_ratios;
     Counts ca, ce;
-    std::vector<std::uint8_t> flags_ant, flags_exhaustive;
+    std::vector<std::uint8_t> flags_ant, flags_exhaustive, final_ant, final_exhaustive;
     std::vector<std::vector<int>> priorities;
     for (int repeat = 0; repeat < std::max(1, o.repeats); ++repeat) {
-      flags_ant.clear();
-      flags_exhaustive.clear();
+      for (std::vector<std::uint8_t>* v :
+           {&flags_ant, &flags_exhaustive, &final_ant, &final_exhaustive})
+        v->clear();
       priorities.clear();
       run_both(ant, exhaustive, camera, frames, repeat % 2 == 0, ca, ce, flags_ant,
-               flags_exhaustive, priorities);
+               flags_exhaustive, final_ant, final_exhaustive, priorities);
       ratios.push_back(median(ca.cpu_ms) / median(ce.cpu_ms));
       search_ratios.push_back(median(ca.search_cpu_ms) / median(ce.search_cpu_ms));
     }
     row("exhaustive", ce);
     row("ant_colony", ca);
-    long kept = 0, found = 0;
-    for (size_t i = 0; i < flags_exhaustive.size(); ++i) {
-      found += flags_exhaustive[i];
-      kept += flags_exhaustive[i] && flags_ant[i];
+    // "Kept" on the test's own detections and on the final verdicts (tested dynamic or in the
+    // grown mask), which is what SLAM uses; a point the ant colony leaves to region growing
+    // (implied) counts only in the latter.
+    const auto kept_share = [](const std::vector<std::uint8_t>& ex,
+                               const std::vector<std::uint8_t>& an, long& kept, long& found) {
+      kept = found = 0;
+      for (size_t i = 0; i < ex.size(); ++i) {
+        found += ex[i];
+        kept += ex[i] && an[i];
+      }
+      return double(kept) / std::max(1L, found);
+    };
+    long kept = 0, found = 0, kept_final = 0, found_final = 0;
+    const double kept_tested = kept_share(flags_exhaustive, flags_ant, kept, found);
+    long lost_tested = 0, lost_untested = 0, lost_truth = 0, ex_tested_static_lost = 0;
+    for (size_t i = 0; i < final_ant.size(); ++i) {
+      if ((final_exhaustive[i] & 1) && !(final_ant[i] & 1)) {
+        if (final_ant[i] & 2)
+          ++lost_tested;
+        else
+          ++lost_untested;
+        if (final_ant[i] & 4) ++lost_truth;
+        if (!flags_exhaustive[i]) ++ex_tested_static_lost;
+      }
+      final_ant[i] &= 1;
+      final_exhaustive[i] &= 1;
     }
+    std::printf("DIAG mask pixels ex %ld ant %ld\n", ce.mask_pixels, ca.mask_pixels);
     std::printf(
-        "ant colony keeps %.3f of the exhaustive test's dynamic detections (%ld of %ld); "
-        "time ratio ant/exhaustive (median of %d runs): module %.3f, search %.3f\n",
-        double(kept) / std::max(1L, found), kept, found, std::max(1, o.repeats), median(ratios),
+        "DIAG lost: ant tested %ld, ant untested %ld, truly dynamic %ld, ex test static (mask "
+        "only) %ld\n",
+        lost_tested, lost_untested, lost_truth, ex_tested_static_lost);
+    const double kept_verdicts = kept_share(final_exhaustive, final_ant, kept_final, found_final);
+    std::printf(
+        "ant colony keeps %.3f of the exhaustive final dynamic verdicts (%ld of %ld) and %.3f of "
+        "its tested detections (%ld of %ld); implied (untested) share %.3f; time ratio "
+        "ant/exhaustive (median of %d runs): module %.3f, search %.3f\n",
+        kept_verdicts, kept_final, found_final, kept_tested, kept, found,
+        double(ca.implied) / std::max(1L, ca.points), std::max(1, o.repeats), median(ratios),
         median(search_ratios));
     if (o.bookkeeping)
       bookkeeping_report(base, camera, frames, flags_exhaustive, priorities, o.repeats);

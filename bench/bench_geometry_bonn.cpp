@@ -14,14 +14,11 @@
 //
 //   bench_geometry_bonn [--frames N] [--shared DIR] [--poses FILE] [--pool-size N] [--repeats N]
 //                       [--node-spacing PX] [--dump FILE] [--system-inputs 0|1]
-//                       [--implied-radius PX] [--implied-join 0|1]
 //   --system-inputs 1 (default): the stage gets what System gives it: the previous -> current
 //   homography computed beforehand (System's flow step) and no keypoint depths (read lazily by
 //   the stage, only for the points it needs); the stage time is then System's geometry step.
 //   0: the stage gets the ORB matches (estimates H itself, "module" time) and the depths.
 //   --dump FILE: per-frame CSV of the last pass (CPU ms per part and counts of both strategies).
-//   --implied-radius 0: the ant colony tests every point it visits (the behaviour before
-//   search.implied_radius_px), for before/after runs with one build.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -96,11 +93,6 @@ int main(int argc, char** argv) {
   fs::path poses_file;
   fs::path dump_file;
   bool system_inputs = true;
-  float implied_radius = -1.0f;  // < 0: the default of AntColonyParams
-  int implied_join = -1;
-  int implied_static = -1;
-  int min_valid = -1;
-  float static_guard = -1.0f;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--frames") max_frames = std::stoi(argv[i + 1]);
@@ -111,11 +103,6 @@ int main(int argc, char** argv) {
     if (key == "--node-spacing") node_spacing = std::stof(argv[i + 1]);
     if (key == "--dump") dump_file = argv[i + 1];
     if (key == "--system-inputs") system_inputs = std::stoi(argv[i + 1]) != 0;
-    if (key == "--implied-radius") implied_radius = std::stof(argv[i + 1]);
-    if (key == "--implied-join") implied_join = std::stoi(argv[i + 1]);
-    if (key == "--implied-static") implied_static = std::stoi(argv[i + 1]);
-    if (key == "--implied-static-guard") static_guard = std::stof(argv[i + 1]);
-    if (key == "--implied-static-min-valid") min_valid = std::stoi(argv[i + 1]);
   }
   Trajectory poses;
   if (!poses_file.empty()) poses = read_tum_trajectory(poses_file);
@@ -302,14 +289,8 @@ int main(int argc, char** argv) {
   GeometryParams ant_params, exhaustive_params;
   exhaustive_params.search.strategy = SearchStrategy::exhaustive;
   if (node_spacing > 0.0f) ant_params.search.node_spacing_px = node_spacing;
-  if (implied_radius >= 0.0f) ant_params.search.implied_radius_px = implied_radius;
-  if (implied_join >= 0) ant_params.search.implied_join_community = implied_join != 0;
-  if (implied_static >= 0) ant_params.search.implied_static = implied_static != 0;
-  if (min_valid >= 0) ant_params.search.implied_static_min_valid = min_valid;
-  if (static_guard >= 0.0f) ant_params.search.implied_static_guard_px = static_guard;
   std::vector<double> ant_cpu, ex_cpu, ant_wall, ex_wall, ant_search, ex_search, tested_share;
   std::vector<double> ant_no_h, ex_no_h, selection, ant_region, ex_region, last_band_share;
-  std::vector<double> implied_share;
   std::vector<double> pass_module_ratio, pass_search_ratio, pass_no_h_ratio;
   // The per-frame times are bimodal (static room frames: few dynamic points; crowd frames: half
   // the points on people), so a median can sit between the modes and jump between passes. The
@@ -334,16 +315,15 @@ int main(int argc, char** argv) {
     return median(a) / median(e);
   };
   long static_flags = 0, static_points = 0, crowd_flags = 0, crowd_points = 0, kept = 0, found = 0;
-  long kept_final = 0, found_final = 0;  // on the final verdicts (tested dynamic or in the mask)
-  // The same on the crowd frames only: the exhaustive's dynamic verdicts in the person-free
-  // frames are false positives, so keeping them is no merit.
-  long crowd_kept_final = 0, crowd_found_final = 0;
-  long lost_kind[3][2][2] = {};
+  // "Kept" also on the final verdicts (tested dynamic or in the grown mask: what SLAM uses), over
+  // all frames and over the crowd frames only: the exhaustive's dynamic verdicts in the
+  // person-free frames are false positives, keeping them is no merit.
+  long kept_final = 0, found_final = 0, crowd_kept_final = 0, crowd_found_final = 0;
   for (int pass = 0; pass < std::max(1, repeats); ++pass) {
     GeometryStage ant(ideal, ant_params), exhaustive(ideal, exhaustive_params);
     for (std::vector<double>* v :
          {&ant_cpu, &ex_cpu, &ant_wall, &ex_wall, &ant_search, &ex_search, &tested_share, &ant_no_h,
-          &ex_no_h, &selection, &ant_region, &ex_region, &last_band_share, &implied_share})
+          &ex_no_h, &selection, &ant_region, &ex_region, &last_band_share})
       v->clear();
     static_flags = static_points = crowd_flags = crowd_points = kept = found = 0;
     kept_final = found_final = crowd_kept_final = crowd_found_final = 0;
@@ -353,8 +333,7 @@ int main(int argc, char** argv) {
     if (last_pass && !dump_file.empty()) {
       dump.open(dump_file);
       dump << "frame,points,strategy,total,homography,selection,search,region,tested,"
-              "tested_dynamic,dynamic,mask_pixels,last_band_tests,implied,implied_static,band_"
-              "rounds\n";
+              "tested_dynamic,dynamic,mask_pixels,last_band_tests\n";
     }
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const StageFrame& sf = stage_frames[k];
@@ -389,9 +368,7 @@ int main(int argc, char** argv) {
                << t.total_cpu_ms << ',' << t.homography_cpu_ms << ',' << t.selection_cpu_ms << ','
                << t.search_cpu_ms << ',' << t.region_cpu_ms << ',' << r->tested_count << ','
                << r->tested_dynamic_count << ',' << r->dynamic_count << ','
-               << cv::countNonZero(r->dynamic_mask) << ',' << r->last_band_tests << ','
-               << r->implied_count << ',' << r->implied_static_count << ',' << r->band_rounds
-               << '\n';
+               << cv::countNonZero(r->dynamic_mask) << ',' << r->last_band_tests << '\n';
         }
       }
       ex_cpu.push_back(e.timing.total_cpu_ms);
@@ -412,19 +389,14 @@ int main(int argc, char** argv) {
       for (size_t q = 0; q < frames[i].keypoints.size(); ++q) {
         found += e.keypoint_tested_dynamic[q];
         kept += e.keypoint_tested_dynamic[q] && a.keypoint_tested_dynamic[q];
+        const long both = e.keypoint_dynamic[q] && a.keypoint_dynamic[q];
         found_final += e.keypoint_dynamic[q];
+        kept_final += both;
         if (frame_index[i] >= 220) {
           crowd_found_final += e.keypoint_dynamic[q];
-          crowd_kept_final += e.keypoint_dynamic[q] && a.keypoint_dynamic[q];
+          crowd_kept_final += both;
         }
-        if (e.keypoint_dynamic[q] && !a.keypoint_dynamic[q]) {
-          const int kind = a.keypoint_implied[q] == 2 ? 0 : a.keypoint_tested[q] ? 1 : 2;
-          ++lost_kind[kind][frame_index[i] >= 215][e.keypoint_tested_dynamic[q]];
-        }
-        kept_final += e.keypoint_dynamic[q] && a.keypoint_dynamic[q];
       }
-      implied_share.push_back(double(a.implied_count) /
-                              std::max<size_t>(1, frames[i].keypoints.size()));
       if (frame_index[i] < 215) {
         static_flags += a.dynamic_count;
         static_points += static_cast<long>(frames[i].keypoints.size());
@@ -450,14 +422,6 @@ int main(int argc, char** argv) {
     std::printf("  pass %d: ratio ant/exhaustive module %.3f, search %.3f, without H %.3f\n", pass,
                 pass_module_ratio.back(), pass_search_ratio.back(), pass_no_h_ratio.back());
   }
-  for (int k = 0; k < 3; ++k)
-    for (int c = 0; c < 2; ++c)
-      std::printf("DIAG lost %s %s: ex tested dyn %ld, ex mask only %ld\n",
-                  k == 0   ? "implied-static"
-                  : k == 1 ? "tested"
-                           : "unvisited",
-                  c ? "crowd" : "static", lost_kind[k][c][1] / std::max(1, repeats),
-                  lost_kind[k][c][0] / std::max(1, repeats));
   std::printf("  median over %d passes: ratio module %.3f, search %.3f, without H %.3f\n",
               std::max(1, repeats), median(pass_module_ratio), median(pass_search_ratio),
               median(pass_no_h_ratio));
@@ -484,12 +448,11 @@ int main(int argc, char** argv) {
   std::printf(
       "  last pass: ratio ant/exhaustive of medians: module %.3f, search %.3f; ant tests %.3f of "
       "points "
-      "(median); keeps %.3f of the exhaustive final dynamic verdicts (%ld of %ld), %.3f of its "
-      "tested detections (%ld of %ld); crowd frames >=220: %.3f of the final verdicts (%ld of "
-      "%ld)\n",
+      "(median); keeps %.3f of the exhaustive test's detections (%ld of %ld), %.3f of its final "
+      "dynamic verdicts (%ld of %ld), in the crowd frames >=220 %.3f (%ld of %ld)\n",
       median(ant_cpu) / median(ex_cpu), median(ant_search) / median(ex_search),
-      median(tested_share), double(kept_final) / std::max(1L, found_final), kept_final, found_final,
-      double(kept) / std::max(1L, found), kept, found,
+      median(tested_share), double(kept) / std::max(1L, found), kept, found,
+      double(kept_final) / std::max(1L, found_final), kept_final, found_final,
       double(crowd_kept_final) / std::max(1L, crowd_found_final), crowd_kept_final,
       crowd_found_final);
   std::printf(
@@ -499,20 +462,17 @@ int main(int argc, char** argv) {
       median(ant_no_h), median(ex_no_h), median(ant_no_h) / median(ex_no_h), median(selection),
       median(ant_region), median(ex_region));
   {
-    std::vector<double> crowd_tested, static_tested, crowd_last_band, crowd_implied;
+    std::vector<double> crowd_tested, static_tested, crowd_last_band;
     for (size_t k = 0; k < stage_frames.size(); ++k) {
       const int index = frame_index[stage_frames[k].index];
       if (index >= 220) crowd_tested.push_back(tested_share[k]);
       if (index >= 220) crowd_last_band.push_back(last_band_share[k]);
-      if (index >= 220) crowd_implied.push_back(implied_share[k]);
       if (index < 215) static_tested.push_back(tested_share[k]);
     }
     std::printf(
         "  ant colony tested share (median): static frames <215 %.3f, crowd frames >=220 %.3f, "
-        "of which in the last (empty) band rounds %.3f; implied (not tested) in crowd frames "
-        "%.3f\n",
-        median(static_tested), median(crowd_tested), median(crowd_last_band),
-        median(crowd_implied));
+        "of which in the last (empty) band rounds %.3f\n",
+        median(static_tested), median(crowd_tested), median(crowd_last_band));
   }
   std::printf(
       "  dynamic share of keypoints (ant colony, final flags): static room frames <215 "

@@ -69,7 +69,6 @@ struct Frame {
 
 struct Counts {
   long tp = 0, fp = 0, fn = 0, test_tp = 0, test_fp = 0, test_fn = 0, tested = 0, points = 0;
-  long implied = 0, mask_pixels = 0;
   std::vector<double> cpu_ms, search_cpu_ms, selection_cpu_ms, region_cpu_ms;
   double recall() const { return double(tp) / std::max(1L, tp + fn); }
   double precision() const { return double(tp) / std::max(1L, tp + fp); }
@@ -127,11 +126,9 @@ struct StrategyRun {
       c.test_fp += !truth && test;
       c.test_fn += truth && !test;
       if (tested_dynamic) tested_dynamic->push_back(test);
-      if (final_dynamic) final_dynamic->push_back(flag + 2 * r.keypoint_tested[i] + 4 * truth);
+      if (final_dynamic) final_dynamic->push_back(flag);
     }
     c.tested += r.tested_count;
-    c.implied += r.implied_count;
-    c.mask_pixels += cv::countNonZero(r.dynamic_mask);
     c.points += long(f.keypoints.size());
     c.cpu_ms.push_back(r.timing.total_cpu_ms);
     c.search_cpu_ms.push_back(r.timing.search_cpu_ms);
@@ -502,8 +499,7 @@ int main(int argc, char** argv) {
     row("exhaustive", ce);
     row("ant_colony", ca);
     // "Kept" on the test's own detections and on the final verdicts (tested dynamic or in the
-    // grown mask), which is what SLAM uses; a point the ant colony leaves to region growing
-    // (implied) counts only in the latter.
+    // grown mask), which is what SLAM uses.
     const auto kept_share = [](const std::vector<std::uint8_t>& ex,
                                const std::vector<std::uint8_t>& an, long& kept, long& found) {
       kept = found = 0;
@@ -515,32 +511,13 @@ int main(int argc, char** argv) {
     };
     long kept = 0, found = 0, kept_final = 0, found_final = 0;
     const double kept_tested = kept_share(flags_exhaustive, flags_ant, kept, found);
-    long lost_tested = 0, lost_untested = 0, lost_truth = 0, ex_tested_static_lost = 0;
-    for (size_t i = 0; i < final_ant.size(); ++i) {
-      if ((final_exhaustive[i] & 1) && !(final_ant[i] & 1)) {
-        if (final_ant[i] & 2)
-          ++lost_tested;
-        else
-          ++lost_untested;
-        if (final_ant[i] & 4) ++lost_truth;
-        if (!flags_exhaustive[i]) ++ex_tested_static_lost;
-      }
-      final_ant[i] &= 1;
-      final_exhaustive[i] &= 1;
-    }
-    std::printf("DIAG mask pixels ex %ld ant %ld\n", ce.mask_pixels, ca.mask_pixels);
-    std::printf(
-        "DIAG lost: ant tested %ld, ant untested %ld, truly dynamic %ld, ex test static (mask "
-        "only) %ld\n",
-        lost_tested, lost_untested, lost_truth, ex_tested_static_lost);
     const double kept_verdicts = kept_share(final_exhaustive, final_ant, kept_final, found_final);
     std::printf(
-        "ant colony keeps %.3f of the exhaustive final dynamic verdicts (%ld of %ld) and %.3f of "
-        "its tested detections (%ld of %ld); implied (untested) share %.3f; time ratio "
-        "ant/exhaustive (median of %d runs): module %.3f, search %.3f\n",
-        kept_verdicts, kept_final, found_final, kept_tested, kept, found,
-        double(ca.implied) / std::max(1L, ca.points), std::max(1, o.repeats), median(ratios),
-        median(search_ratios));
+        "ant colony keeps %.3f of the exhaustive test's dynamic detections (%ld of %ld) and %.3f "
+        "of its final dynamic verdicts (%ld of %ld); time ratio ant/exhaustive (median of %d "
+        "runs): module %.3f, search %.3f\n",
+        kept_tested, kept, found, kept_verdicts, kept_final, found_final, std::max(1, o.repeats),
+        median(ratios), median(search_ratios));
     if (o.bookkeeping)
       bookkeeping_report(base, camera, frames, flags_exhaustive, priorities, o.repeats);
   };

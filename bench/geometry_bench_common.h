@@ -36,16 +36,6 @@ inline void apply_geometry_override(GeometryParams& p, const std::string& key, d
     p.search.node_spacing_px = float(value);
   else if (key == "lane_spacing_px")
     p.search.lane_spacing_px = float(value);
-  else if (key == "implied_radius_px")
-    p.search.implied_radius_px = float(value);
-  else if (key == "implied_static_min_valid")
-    p.search.implied_static_min_valid = int(value);
-  else if (key == "implied_static_guard_px")
-    p.search.implied_static_guard_px = float(value);
-  else if (key == "implied_static")
-    p.search.implied_static = value > 0;
-  else if (key == "implied_join_community")
-    p.search.implied_join_community = value > 0;
   else if (key == "alternate_lanes")
     p.search.alternate_lanes = value > 0;
   else if (key == "exhaustive")

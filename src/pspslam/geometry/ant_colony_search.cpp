@@ -36,8 +36,6 @@ AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
   p.lane_spacing_px = section.optional("lane_spacing_px", p.lane_spacing_px);
   require(p.lane_spacing_px > 0.0f, section, "lane_spacing_px", "must be > 0");
   p.alternate_lanes = section.optional("alternate_lanes", p.alternate_lanes);
-  p.implied_radius_px = section.optional("implied_radius_px", p.implied_radius_px);
-  require(p.implied_radius_px >= 0.0f, section, "implied_radius_px", "must be >= 0");
   p.max_band_rounds = section.optional("max_band_rounds", p.max_band_rounds);
   require(p.max_band_rounds >= 1, section, "max_band_rounds", "must be >= 1");
   section.finish();
@@ -64,10 +62,10 @@ void DynamicPointSearch::build_grid(std::span<const Eigen::Vector2f> points, cv:
   }
   for (size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_points_.resize(points.size());
-  // Unvisited (neither tested nor implied) points per cell: cells a community has exhausted are
-  // skipped without a look at their points in later band rounds and path nodes.
-  cell_unvisited_.resize(cells);
-  for (size_t c = 0; c < cells; ++c) cell_unvisited_[c] = cell_start_[c + 1] - cell_start_[c];
+  // Untested points per cell: cells a community has exhausted are skipped without a look at
+  // their points in later band rounds and path nodes.
+  cell_untested_.resize(cells);
+  for (size_t c = 0; c < cells; ++c) cell_untested_[c] = cell_start_[c + 1] - cell_start_[c];
   cell_cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (size_t i = 0; i < points.size(); ++i) {
     cell_points_[cell_cursor_[point_cell_[i]]++] = static_cast<int>(i);
@@ -96,25 +94,11 @@ void DynamicPointSearch::build_paths(cv::Size image_size) {
   }
 }
 
-bool DynamicPointSearch::visit(int index) {
-  visited_[index] = 1;
-  if (!point_cell_.empty()) --cell_unvisited_[point_cell_[index]];
-  if (implied_) {
-    const ImpliedVerdict verdict = (*implied_)(index);
-    if (verdict == ImpliedVerdict::dynamic) {
-      result_.implied[index] = 1;
-      ++result_.implied_count;
-      return params_.implied_join_community;
-    }
-    if (verdict == ImpliedVerdict::static_) {
-      result_.implied[index] = 2;
-      ++result_.implied_static_count;
-      return false;
-    }
-  }
+bool DynamicPointSearch::test(int index, const PointPredicate& is_dynamic) {
   result_.tested[index] = 1;
   ++result_.tested_count;
-  const bool dynamic = (*is_dynamic_)(index);
+  if (!point_cell_.empty()) --cell_untested_[point_cell_[index]];
+  const bool dynamic = is_dynamic(index);
   if (dynamic) {
     result_.dynamic[index] = 1;
     ++result_.dynamic_count;
@@ -123,16 +107,17 @@ bool DynamicPointSearch::visit(int index) {
 }
 
 template <typename InBand>
-void DynamicPointSearch::visit_cell(int cell, std::span<const Eigen::Vector2f> points,
-                                    const InBand& in_band) {
+void DynamicPointSearch::test_cell(int cell, std::span<const Eigen::Vector2f> points,
+                                   const PointPredicate& is_dynamic, const InBand& in_band) {
   for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
     const int index = cell_points_[k];
-    if (visited_[index] || !in_band(points[index])) continue;
-    if (visit(index)) found_.push_back(index);
+    if (result_.tested[index] || !in_band(points[index])) continue;
+    if (test(index, is_dynamic)) found_.push_back(index);
   }
 }
 
-void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points) {
+void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
+                                        const PointPredicate& is_dynamic) {
   ++result_.communities;
   const float band = params_.band_width_px;
   const float half_cell = cell_size_ / 2.0f;
@@ -204,7 +189,7 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points)
       }
       for (int col = first; col <= last; ++col) {
         const int cell = row * grid_cols_ + col;
-        if (cell_unvisited_[cell] == 0) continue;
+        if (cell_untested_[cell] == 0) continue;
         const Eigen::Vector2f centre((col + 0.5f) * cell_size_, (row + 0.5f) * cell_size_);
         bool inside = true, outside = false;
         if (polygon) {
@@ -223,9 +208,9 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points)
         }
         if (outside) continue;
         if (inside)
-          visit_cell(cell, points, anywhere);
+          test_cell(cell, points, is_dynamic, anywhere);
         else
-          visit_cell(cell, points, in_band);
+          test_cell(cell, points, is_dynamic, in_band);
       }
     }
     if (found_.empty()) {  // a band without new dynamic points ends this community
@@ -238,24 +223,17 @@ void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points)
 
 const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> points,
                                             cv::Size image_size, const PointPredicate& is_dynamic,
-                                            std::span<const int> priority,
-                                            const PointImplication& implied) {
+                                            std::span<const int> priority) {
   const size_t n = points.size();
   result_.dynamic.assign(n, 0);
   result_.tested.assign(n, 0);
-  result_.implied.assign(n, 0);
-  visited_.assign(n, 0);
-  result_.tested_count = result_.implied_count = result_.implied_static_count =
-      result_.dynamic_count = result_.communities = result_.band_rounds = result_.last_band_tests =
-          0;
+  result_.tested_count = result_.dynamic_count = result_.communities = result_.band_rounds =
+      result_.last_band_tests = 0;
   if (n == 0) return result_;
-  is_dynamic_ = &is_dynamic;
-  // The baseline tests every point: nothing is implied there.
-  implied_ = params_.strategy == SearchStrategy::ant_colony && implied ? &implied : nullptr;
 
   if (params_.strategy == SearchStrategy::exhaustive) {
     point_cell_.clear();  // no grid bookkeeping in the baseline
-    for (size_t i = 0; i < n; ++i) visit(static_cast<int>(i));
+    for (size_t i = 0; i < n; ++i) test(static_cast<int>(i), is_dynamic);
     return result_;
   }
 
@@ -264,10 +242,10 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   const int phase = params_.alternate_lanes ? static_cast<int>(run_count_++ & 1u) : 0;
 
   for (int index : priority) {
-    if (index < 0 || static_cast<size_t>(index) >= n || visited_[index]) continue;
-    if (!visit(index)) continue;
+    if (index < 0 || static_cast<size_t>(index) >= n || result_.tested[index]) continue;
+    if (!test(index, is_dynamic)) continue;
     community_.assign(1, points[index]);
-    grow_community(points);
+    grow_community(points, is_dynamic);
   }
 
   const float radius2 = params_.search_radius_px * params_.search_radius_px;
@@ -288,14 +266,14 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
     for (int r = row0; r <= row1; ++r) {
       for (int c = col0; c <= col1; ++c) {
         const int cell = r * grid_cols_ + c;
-        if (cell_unvisited_[cell] != 0) visit_cell(cell, points, near_node);
+        if (cell_untested_[cell] != 0) test_cell(cell, points, is_dynamic, near_node);
       }
     }
     // A find leaves the path: grow this community's hull, then go on at K_{i+1}.
     if (found_.empty()) continue;
     community_.clear();
     for (int index : found_) community_.push_back(points[index]);
-    grow_community(points);
+    grow_community(points, is_dynamic);
   }
   return result_;
 }

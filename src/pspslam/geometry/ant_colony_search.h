@@ -34,16 +34,6 @@ struct AntColonyParams {
   // points (previous mask) instead of the path.
   bool alternate_lanes = true;
   int max_band_rounds = 256;  // safety bound; a round that finds nothing ends growth anyway
-  // Implied points: an unvisited point within this distance of a dynamic point found earlier in
-  // the frame, whose depth continues that point's surface (one region-growing depth step), is not
-  // tested: GeometryStage gives it to region growing as a seed, as it would a tested dynamic
-  // point (docs/geometry.md, "Implied points"). 0 = test every visited point.
-  float implied_radius_px = 0.0f;
-  // DEV: implied points (see run()) join their community's hull like found dynamic points.
-  bool implied_join_community = true;
-  bool implied_static = true;            // DEV
-  int implied_static_min_valid = 0;      // DEV
-  float implied_static_guard_px = 0.0f;  // DEV
 
   // Reads the optional keys of a `search:` section (strategy: ant_colony | exhaustive).
   static AntColonyParams from_yaml(YamlSection& section);
@@ -52,12 +42,7 @@ struct AntColonyParams {
 struct SearchResult {
   std::vector<std::uint8_t> dynamic;  // 1 = tested and found dynamic; untested count as static
   std::vector<std::uint8_t> tested;
-  // Not tested because the caller's `implied` gave the verdict: 1 = dynamic (the point continues
-  // the surface of a dynamic point found earlier), 2 = static; 0 = tested or not visited.
-  std::vector<std::uint8_t> implied;
   int tested_count = 0;
-  int implied_count = 0;         // implied dynamic
-  int implied_static_count = 0;  // not tested, implied static (count as static like untested)
   int dynamic_count = 0;
   int communities = 0;  // dynamic clusters grown from a path node or a priority point
   int band_rounds = 0;  // hull-band rounds over all communities
@@ -69,14 +54,6 @@ struct SearchResult {
 // Index of a candidate point -> is it dynamic (the multi-view test). Called at most once per point.
 using PointPredicate = std::function<bool(int)>;
 
-// What a point's surroundings already say about it, so that it needs no test.
-enum class ImpliedVerdict : std::uint8_t {
-  none,     // unknown: test it
-  dynamic,  // it continues the surface of a dynamic point found earlier
-  static_,  // it continues the surface of a point tested static (and of no dynamic one)
-};
-using PointImplication = std::function<ImpliedVerdict(int)>;
-
 // Reusable searcher: buffers (grid buckets, hull, community) are kept between frames so a frame
 // costs no allocation once sizes have settled. Not thread-safe; use one per worker thread.
 class DynamicPointSearch {
@@ -86,33 +63,24 @@ class DynamicPointSearch {
   // `points` are pixel positions inside `image_size`. `priority` indices (e.g. points inside the
   // previous frame's dynamic mask warped by the compensated homography) are tested before the
   // path, each a potential community seed. The returned reference stays valid until the next run.
-  //
-  // `implied` (optional, ant colony only) is asked before each test: a point it calls dynamic or
-  // static is not tested and not visited again; an implied dynamic point counts as a find of its
-  // community (its hull grows over it as over a tested one).
   const SearchResult& run(std::span<const Eigen::Vector2f> points, cv::Size image_size,
-                          const PointPredicate& is_dynamic, std::span<const int> priority = {},
-                          const PointImplication& implied = {});
+                          const PointPredicate& is_dynamic, std::span<const int> priority = {});
 
   const AntColonyParams& params() const { return params_; }
 
  private:
   void build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size);
   void build_paths(cv::Size image_size);
-  // Visits an unvisited point: implied (no test) or tested. Returns whether it counts as a find of
-  // the current community (tested dynamic, or implied when implied points join communities).
-  bool visit(int index);
-  // Visits the unvisited points of one grid cell that pass `in_band`; finds go to found_.
+  bool test(int index, const PointPredicate& is_dynamic);
+  // Tests the untested points of one grid cell; `exact` = check each point against the band.
   template <typename InBand>
-  void visit_cell(int cell, std::span<const Eigen::Vector2f> points, const InBand& in_band);
+  void test_cell(int cell, std::span<const Eigen::Vector2f> points,
+                 const PointPredicate& is_dynamic, const InBand& in_band);
   // Grows the community whose first dynamic points are in community_ until a band adds nothing.
-  void grow_community(std::span<const Eigen::Vector2f> points);
+  void grow_community(std::span<const Eigen::Vector2f> points, const PointPredicate& is_dynamic);
 
   AntColonyParams params_;
   SearchResult result_;
-  const PointPredicate* is_dynamic_ = nullptr;  // the predicates of the current run()
-  const PointImplication* implied_ = nullptr;
-  std::vector<std::uint8_t> visited_;  // tested or implied
   // Grid buckets in compressed form: points of cell c are cell_points_[cell_start_[c] ..
   // cell_start_[c + 1]).
   float cell_size_ = 1.0f;
@@ -122,7 +90,7 @@ class DynamicPointSearch {
   std::vector<int> cell_points_;
   std::vector<int> point_cell_;
   std::vector<int> cell_cursor_;
-  std::vector<int> cell_unvisited_;
+  std::vector<int> cell_untested_;
   cv::Size path_size_;
   // Two phases of the path (lanes shifted by half a lane spacing), used on alternate runs.
   std::vector<Eigen::Vector2f> path_nodes_[2];

@@ -77,14 +77,7 @@ GeometryStage::GeometryStage(PinholeCamera camera, GeometryParams params)
                  params.references.point_stride, params.multiview.reference_patch_radius,
                  params.multiview.max_parallax_deg, params.references.older_view_gain_share}),
       search_(params.search),
-      grower_(params.region, static_cast<float>(camera.fx)) {
-  if (params.search.implied_radius_px > 0.0f) {
-    found_dynamic_.emplace(params.search.implied_radius_px, params.region.max_step_abs_m,
-                           params.region.max_step_relative);
-    found_static_.emplace(params.search.implied_radius_px, params.region.max_step_abs_m,
-                          params.region.max_step_relative);
-  }
-}
+      grower_(params.region, static_cast<float>(camera.fx)) {}
 
 GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   const Stopwatch start;
@@ -178,55 +171,26 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   result.timing.selection_ms = selection_start.wall_ms();
   result.timing.selection_cpu_ms = selection_start.cpu_ms();
 
-  // III.C: reverse ant-colony search driving the multi-view test. Implied points (beside a
-  // dynamic point found earlier, on its surface) are not tested but become region seeds below,
-  // as the tested dynamic point beside them would have made them: their final verdict comes from
-  // the grown mask. Only when region growing runs: without it an implied point had no verdict.
-  const bool skip_implied = params_.search.strategy == SearchStrategy::ant_colony &&
-                            found_dynamic_ && params_.region.enabled;
+  // III.C: reverse ant-colony search driving the multi-view test.
   const Stopwatch search_start;
   test_.set_frame(input.T_world_camera, references);
-  if (skip_implied) {
-    found_dynamic_->reset(input.depth.size());
-    found_static_->reset(input.depth.size());
-  }
   const SearchResult& search = search_.run(
       points_, input.depth.size(),
       [&](int index) {
-        const float depth = static_cast<float>(depth_of(static_cast<size_t>(index)));
-        const MultiViewVerdict verdict = test_.evaluate(candidates_[index]);
-        if (skip_implied && verdict.dynamic) found_dynamic_->add(points_[index], depth);
-        if (skip_implied && !verdict.dynamic &&
-            verdict.valid_references >= params_.search.implied_static_min_valid)
-          found_static_->add(points_[index], depth);
-        return verdict.dynamic;
+        depth_of(static_cast<size_t>(index));
+        return test_.is_dynamic(candidates_[index]);
       },
-      priority_,
-      skip_implied ? PointImplication([&](int index) {
-        const Eigen::Vector2f& pixel = points_[index];
-        const float depth = static_cast<float>(depth_of(static_cast<size_t>(index)));
-        const bool beside_dynamic = found_dynamic_->continues(pixel, depth);
-        const bool beside_static =
-            params_.search.implied_static && found_static_->continues(pixel, depth) &&
-            !(params_.search.implied_static_guard_px > 0.0f &&
-              found_dynamic_->any_within(pixel, params_.search.implied_static_guard_px));
-        // On both surfaces at once (a foot on the floor): only the test can tell.
-        if (beside_dynamic == beside_static) return ImpliedVerdict::none;
-        return beside_dynamic ? ImpliedVerdict::dynamic : ImpliedVerdict::static_;
-      })
-                   : PointImplication());
+      priority_);
   result.timing.search_ms = search_start.wall_ms();
   result.timing.search_cpu_ms = search_start.cpu_ms();
 
-  // Region growing from the dynamic (and implied) points; verified-static points may act as
-  // barriers. Seeds go in index order, as in the exhaustive baseline (the order decides which
-  // seed's disc a region gets).
+  // Region growing from the dynamic points; verified-static points may act as barriers.
   const Stopwatch region_start;
   seeds_.clear();
   seed_depths_.clear();
   static_points_.clear();
   for (size_t i = 0; i < n; ++i) {
-    if (search.dynamic[i] || search.implied[i] == 1) {
+    if (search.dynamic[i]) {
       seeds_.push_back(points_[i]);
       seed_depths_.push_back(static_cast<float>(depth_of(i)));
     } else if (search.tested[i]) {
@@ -238,20 +202,16 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
   result.timing.region_cpu_ms = region_start.cpu_ms();
 
   result.keypoint_tested = search.tested;
-  result.keypoint_implied = search.implied;
   result.keypoint_tested_dynamic = search.dynamic;
   result.keypoint_dynamic.assign(n, 0);
   result.tested_count = search.tested_count;
-  result.implied_count = search.implied_count;
-  result.implied_static_count = search.implied_static_count;
   result.tested_dynamic_count = search.dynamic_count;
   result.last_band_tests = search.last_band_tests;
-  result.band_rounds = search.band_rounds;
   for (size_t i = 0; i < n; ++i) {
     const int u = static_cast<int>(points_[i].x()), v = static_cast<int>(points_[i].y());
     const bool in_mask = u >= 0 && v >= 0 && u < result.dynamic_mask.cols &&
                          v < result.dynamic_mask.rows && result.dynamic_mask.at<std::uint8_t>(v, u);
-    result.keypoint_dynamic[i] = search.dynamic[i] || search.implied[i] == 1 || in_mask;
+    result.keypoint_dynamic[i] = search.dynamic[i] || in_mask;
     result.dynamic_count += result.keypoint_dynamic[i];
   }
   result.timing.total_ms = start.wall_ms();

@@ -14,7 +14,6 @@
 #include "pspslam/geometry/multiview_test.h"
 #include "pspslam/geometry/reference_selection.h"
 #include "pspslam/geometry/region_growing.h"
-#include "pspslam/geometry/surface_point_index.h"
 
 namespace pspslam {
 
@@ -86,14 +85,10 @@ struct GeometryFrameResult {
   std::vector<std::uint8_t> keypoint_dynamic;
   std::vector<std::uint8_t> keypoint_tested;
   std::vector<std::uint8_t> keypoint_tested_dynamic;
-  std::vector<std::uint8_t> keypoint_implied;  // SearchResult::implied (1 dynamic, 2 static)
   int tested_count = 0;
-  int implied_count = 0;         // not tested, dynamic: beside a dynamic point, on its surface
-  int implied_static_count = 0;  // not tested, static: beside a static point, on its surface
   int references_used = 0;
   int tested_dynamic_count = 0;
   int last_band_tests = 0;  // SearchResult::last_band_tests
-  int band_rounds = 0;      // SearchResult::band_rounds
   int dynamic_count = 0;
   CompensatedHomography homography;  // valid = false when no matches were given
   // Previous mask in the motion-compensated frame (only with output_warped_previous_mask).
@@ -120,9 +115,6 @@ class GeometryStage {
   ReferenceSelector selector_;
   DynamicPointSearch search_;
   DynamicRegionGrower grower_;
-  // Points tested so far in the frame, by verdict (with search.implied_radius_px > 0).
-  std::optional<SurfacePointIndex> found_dynamic_;
-  std::optional<SurfacePointIndex> found_static_;
   std::vector<Eigen::Vector2f> points_;
   std::vector<CandidatePoint> candidates_;
   std::vector<int> priority_;

@@ -43,6 +43,37 @@ namespace {
 
 // Conventional status of a process stopped by SIGINT (128 + 2).
 constexpr int kInterruptedExit = 130;
+// The whole sequence ran and no frame ever started a map: nothing was tracked.
+constexpr int kNeverStartedExit = 3;
+
+// Watches the frames before the first map. A sequence without depth readings never starts; the
+// user is told so (once, after `warn_after` such frames) with the best frame's
+// depth count, not left with an empty trajectory and no reason.
+class StartWatch {
+ public:
+  explicit StartWatch(size_t warn_after) : warn_after_(warn_after) {}
+
+  void update(const TrackResult& result) {
+    if (result.state != TrackingState::kNotInitialized) started_ = true;
+    if (started_ || result.keypoints_with_depth_needed == 0) return;
+    best_ = std::max(best_, result.keypoints_with_depth);
+    needed_ = result.keypoints_with_depth_needed;
+    if (++waiting_ == warn_after_) std::cerr << "warning: " << reason() << "\n";
+  }
+  bool never_started() const { return !started_ && waiting_ > 0; }
+  std::string reason() const {
+    return "no map after " + std::to_string(waiting_) + " frames: the best frame had " +
+           std::to_string(best_) + " keypoints with a depth reading, " + std::to_string(needed_) +
+           " are needed to start one (are the depth images listed in depth.txt empty?)";
+  }
+
+ private:
+  size_t warn_after_;
+  size_t waiting_ = 0;
+  int best_ = 0;
+  int needed_ = 0;
+  bool started_ = false;
+};
 
 double median(std::vector<double> values) {
   if (values.empty()) return 0.0;
@@ -341,6 +372,9 @@ int run_command(const std::vector<std::string>& args) {
     return loaded;
   };
   size_t relocalisations = 0;
+  // Frames before the first map: a sequence that never starts (no depth readings) is told why,
+  // after a second of video and again at the end, instead of ending with 0 poses.
+  StartWatch start_watch(static_cast<size_t>(std::max(1.0, setup.config.camera.fps)));
   std::optional<size_t> first_pose_after_blackout;
   std::string first_method_after_blackout;
   for (size_t i = 0; i < frames; ++i) {
@@ -377,6 +411,7 @@ int run_command(const std::vector<std::string>& args) {
       exporter->remember_keyframe(system.map().max_keyframe_id(), frame.bgr, frame.depth,
                                   system.last_dynamic_mask());
     if (result.method == TrackingMethod::kRelocalisation) ++relocalisations;
+    start_watch.update(result);
     if (blackout && i >= blackout->end() && !first_pose_after_blackout && result.T_world_camera) {
       first_pose_after_blackout = i;
       first_method_after_blackout = to_string(result.method);
@@ -618,6 +653,10 @@ int run_command(const std::vector<std::string>& args) {
     std::cout << "interrupted after " << processed << " of " << frames
               << " frames; trajectory.txt holds every pose computed so far\n";
     return kInterruptedExit;
+  }
+  if (processed > 0 && trajectory.count() == 0 && start_watch.never_started()) {
+    std::cerr << "error: " << start_watch.reason() << "\n";
+    return kNeverStartedExit;
   }
   return 0;
 }

@@ -234,6 +234,31 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
   }
 }
 
+// A sequence whose depth images are all empty never starts a map: `run` says why after a second
+// of frames (the sequence's fps) and again at the end, and exits with status 3, leaving a valid
+// (empty) trajectory and stats.json.
+TEST(CliRun, SequenceWithoutDepthSaysWhyNoMapStarts) {
+  const auto dir = testing::make_temp_dir("cli_no_depth");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 0 --seed 2");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "seq" / "depth"))
+    cv::imwrite(entry.path().string(), cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)));
+  const auto out = dir / "out";
+  const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " + out.string() +
+                           " --dynamic off");
+  EXPECT_EQ(r.status, 3) << r.output;
+  const std::string why =
+      " keypoints with a depth reading, 500 are needed to start one (are the depth images listed "
+      "in depth.txt empty?)\n";
+  EXPECT_TRUE(contains(r.output, "warning: no map after 30 frames: the best frame had 0" + why))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "error: no map after 40 frames: the best frame had 0" + why))
+      << r.output;
+  EXPECT_TRUE(read_tum_trajectory(out / "trajectory.txt").empty());
+  EXPECT_TRUE(std::filesystem::exists(out / "stats.json"));
+}
+
 // --export-map / --export-dense on a rendered room: the map PLY holds exactly the map points
 // the run reports, and the dense cloud, carried into the renderer's world with the first ground
 // truth pose (SLAM's world is the first camera), lies inside the 7 x 6 x 2.8 m room.

@@ -60,7 +60,7 @@ TrackResult Tracker::track(Frame frame) {
   result.num_keypoints = frame.size();
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (initialize(frame)) {
+    if (initialize(frame, result)) {
       state_ = TrackingState::kOk;
       result.method = TrackingMethod::kInitialization;
       result.keyframe_inserted = true;
@@ -152,9 +152,11 @@ std::optional<Pose> Tracker::last_tracked_world_pose() const {
   return last_tracked_pose_->inverse();
 }
 
-bool Tracker::initialize(Frame& frame) {
+bool Tracker::initialize(Frame& frame, TrackResult& result) {
   int with_depth = 0;
   for (int i = 0; i < frame.size(); ++i) with_depth += frame.depth(i) > 0.0f ? 1 : 0;
+  result.keypoints_with_depth = with_depth;
+  result.keypoints_with_depth_needed = options_.min_initial_depth_points;
   if (with_depth < options_.min_initial_depth_points) return false;
   // The first camera defines the world frame.
   frame.set_pose(Pose::Identity());

@@ -67,6 +67,10 @@ struct TrackResult {
   bool keyframe_inserted = false;
   int num_keypoints = 0;
   int num_inliers = 0;  // map point matches after local map tracking
+  // Frames before the map exists: keypoints with a depth reading, against the number the first
+  // map needs (so a caller can say why a sequence never starts, e.g. a wrong depth factor).
+  int keypoints_with_depth = 0;
+  int keypoints_with_depth_needed = 0;
 };
 
 // Tracking of each frame (ORB-SLAM2 RGB-D semantics): map initialisation from the first frame
@@ -111,7 +115,7 @@ class Tracker {
   const TrackerOptions& options() const { return options_; }
 
  private:
-  bool initialize(Frame& frame);
+  bool initialize(Frame& frame, TrackResult& result);
   bool track_with_motion_model(Frame& frame);
   bool track_reference_keyframe(Frame& frame, bool recovering);
   bool relocalize(Frame& frame);

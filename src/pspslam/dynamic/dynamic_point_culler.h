@@ -38,8 +38,6 @@ class DynamicPointCuller {
       std::span<const std::shared_ptr<MapPoint>> points, const Pose& T_world_camera,
       const cv::Mat& dynamic_mask, const cv::Mat& depth, const PinholeCamera& camera);
 
-  size_t tracked_points() const { return hits_.size(); }
-
  private:
   DynamicCullingParams params_;
   std::unordered_map<std::uint64_t, int> hits_;

@@ -104,17 +104,6 @@ Eigen::Vector3d KeyFrame::unproject_world(int i) const {
   return T_world_camera() * camera_->pinhole.unproject({p.x, p.y}, depth_[i]);
 }
 
-double KeyFrame::median_scene_depth() const {
-  const Pose T_cw = T_camera_world();
-  std::vector<double> depths;
-  for (const auto& point : map_points()) {
-    if (point) depths.push_back((T_cw * point->position()).z());
-  }
-  if (depths.empty()) return 0.0;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  return depths[depths.size() / 2];
-}
-
 void KeyFrame::add_map_point(int index, const std::shared_ptr<MapPoint>& point) {
   std::lock_guard lock(features_mutex_);
   map_points_[index] = point;

@@ -71,8 +71,6 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
     grid_.query(keypoints_, x, y, radius, min_level, max_level, out);
   }
   Eigen::Vector3d unproject_world(int i) const;  // needs depth(i) > 0
-  // Median depth of its map points in this camera (for baseline checks in mapping).
-  double median_scene_depth() const;
 
   // --- bag of words (thread-safe). Computed once, by local mapping (off the tracking thread),
   // before the keyframe enters the KeyFrameDatabase; immutable afterwards, so a keyframe found

@@ -187,16 +187,6 @@ double MapPoint::found_ratio() const {
   return static_cast<double>(found_) / visible_;
 }
 
-int MapPoint::visible_count() const {
-  std::lock_guard lock(observation_mutex_);
-  return visible_;
-}
-
-int MapPoint::found_count() const {
-  std::lock_guard lock(observation_mutex_);
-  return found_;
-}
-
 void MapPoint::set_bad() {
   std::map<std::uint64_t, Observation> observations;
   {

@@ -59,8 +59,6 @@ class MapPoint {
   void increase_visible(int n = 1);
   void increase_found(int n = 1);
   double found_ratio() const;
-  int visible_count() const;
-  int found_count() const;
 
   // Marks the point bad and detaches it from every keyframe that observed it. The caller
   // removes it from the Map (Map::erase_map_point does both).

@@ -51,8 +51,6 @@ class LocalMapper {
                const std::function<bool()>& has_new_keyframe = {});
 
   const LocalMappingStats& stats() const { return stats_; }
-  // Points still on probation (created during the last few keyframes).
-  size_t recent_point_count() const { return recent_points_.size(); }
 
  private:
   void insert_keyframe_into_map(const std::shared_ptr<KeyFrame>& keyframe);

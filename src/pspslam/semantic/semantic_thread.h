@@ -72,7 +72,6 @@ class SemanticThread {
   void stop();
 
   SemanticStats stats() const;
-  const std::vector<int>& dynamic_class_ids() const { return dynamic_ids_; }
 
  private:
   struct Pending {

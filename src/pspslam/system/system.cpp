@@ -449,7 +449,6 @@ System::System(const SystemConfig& config, SystemOptions options)
           loop->insert_keyframe(keyframe);
         });
   }
-  dynamic_options_ = options.dynamic;
   if (options.dynamic.mode != DynamicMode::off)
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
 }

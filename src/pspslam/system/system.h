@@ -172,7 +172,6 @@ class System {
   // Tracker::refined_trajectory); call after shutdown().
   Trajectory refined_trajectory() const { return tracker_->refined_trajectory(); }
   MappingStats mapping_stats() const;
-  const DynamicOptions& dynamic_options() const { return dynamic_options_; }
   const Map& map() const { return *map_; }
   // Vocabulary + keyframe database; null when PlaceOptions needs no vocabulary.
   const std::shared_ptr<PlaceRecognition>& place_recognition() const { return place_; }
@@ -202,7 +201,6 @@ class System {
   std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
   bool synchronous_local_mapping_ = false;
-  DynamicOptions dynamic_options_;
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker and map go away.
   std::unique_ptr<DynamicPipeline> dynamic_;

@@ -61,6 +61,8 @@ TEST(Config, SaveLoadRoundTrip) {
   config.camera.depth_threshold = 3.5;
   config.camera.depth_noise = CameraConfig::DepthNoise::kinect_v1;
   config.camera.depth_noise_scale = 1.5;
+  config.camera.depth_shift_x = -2;
+  config.camera.depth_shift_y = 1;
   config.orb.n_features = 1500;
   config.orb.scale_factor = 1.3;
   config.orb.n_levels = 6;
@@ -81,6 +83,8 @@ TEST(Config, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded.camera.depth_threshold, 3.5);
   EXPECT_EQ(loaded.camera.depth_noise, CameraConfig::DepthNoise::kinect_v1);
   EXPECT_EQ(loaded.camera.depth_noise_scale, 1.5);
+  EXPECT_EQ(loaded.camera.depth_shift_x, -2);
+  EXPECT_EQ(loaded.camera.depth_shift_y, 1);
   EXPECT_EQ(loaded.orb.n_features, 1500);
   EXPECT_EQ(loaded.orb.scale_factor, 1.3);
   EXPECT_EQ(loaded.orb.n_levels, 6);
@@ -166,6 +170,19 @@ TEST(Config, InvalidValues) {
   const auto noise_scale = write_file(dir, std::string(kValidCamera) + "  depth_noise_scale: 0\n");
   EXPECT_EQ(load_error(noise_scale),
             noise_scale.string() + ": key 'camera.depth_noise_scale' must be > 0");
+  for (const std::string shift : {"[1]", "[0, 17]", "[1, 2, 3]"}) {
+    const auto file = write_file(
+        dir, std::string(kValidCamera) + "  depth_registration_shift_px: " + shift + "\n");
+    EXPECT_EQ(load_error(file), file.string() +
+                                    ": key 'camera.depth_registration_shift_px' must be two whole "
+                                    "pixel offsets [dx, dy], each within +-16")
+        << shift;
+  }
+  const auto fractional =
+      write_file(dir, std::string(kValidCamera) + "  depth_registration_shift_px: [0, 1.5]\n");
+  EXPECT_EQ(
+      load_error(fractional),
+      fractional.string() + ":13: key 'camera.depth_registration_shift_px' has an invalid value");
   const auto broken = write_file(dir, "camera: [1, 2\n");
   EXPECT_EQ(load_error(broken).rfind(broken.string() + ":2: invalid YAML: ", 0), 0u)
       << load_error(broken);

@@ -96,6 +96,33 @@ TEST(RgbdSequence, DepthFactorIsApplied) {
   EXPECT_FLOAT_EQ(frame.depth.at<float>(3, 3), 5.0f);
 }
 
+// The registration shift reads depth pixel (u + dx, v + dy) for colour pixel (u, v); what is
+// shifted in from beyond the border has no reading.
+TEST(RgbdSequence, DepthRegistrationShiftMovesTheDepthImage) {
+  const auto dir = testing::make_temp_dir("depth_shift");
+  cv::Mat raw(6, 8, CV_16UC1);
+  for (int v = 0; v < raw.rows; ++v)
+    for (int u = 0; u < raw.cols; ++u) raw.at<uint16_t>(v, u) = static_cast<uint16_t>(100 * v + u);
+  cv::imwrite((dir / "d.png").string(), raw);
+  const cv::Mat shifted = read_depth_image(dir / "d.png", 1000.0, -2, 1);
+  ASSERT_EQ(shifted.size(), raw.size());
+  for (int v = 0; v < raw.rows; ++v) {
+    for (int u = 0; u < raw.cols; ++u) {
+      const bool inside = u - 2 >= 0 && v + 1 < raw.rows;
+      const float expected = inside ? (100.0f * (v + 1) + (u - 2)) / 1000.0f : 0.0f;
+      EXPECT_FLOAT_EQ(shifted.at<float>(v, u), expected) << u << ", " << v;
+    }
+  }
+  // The sequence applies the shift of its options to every frame.
+  const auto sequence_dir = make_sequence("seq_shift");
+  SequenceOptions options;
+  options.warnings = nullptr;
+  options.depth_shift_y = 1;
+  const RgbdFrame frame = RgbdSequence::open(sequence_dir, options).load(0);
+  EXPECT_FLOAT_EQ(frame.depth.at<float>(0, 1), 1.0f);  // row 1 of the image
+  EXPECT_FLOAT_EQ(frame.depth.at<float>(5, 1), 0.0f);  // shifted in from below the border
+}
+
 TEST(RgbdSequence, MissingFilesSkipFramesWithOneWarning) {
   const auto dir = make_sequence("seq");
   std::filesystem::remove(dir / "depth/10.1050.png");

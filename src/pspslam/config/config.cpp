@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <vector>
 
@@ -45,6 +46,16 @@ CameraConfig read_camera(YamlSection section) {
                 "' must be none or kinect_v1, got '" + depth_noise + "'");
   }
   camera.depth_noise_scale = section.optional("depth_noise_scale", camera.depth_noise_scale);
+  const auto shift = section.optional<std::vector<int>>("depth_registration_shift_px", {0, 0});
+  constexpr int kMaxDepthShift = 16;
+  if (shift.size() != 2 || std::abs(shift[0]) > kMaxDepthShift ||
+      std::abs(shift[1]) > kMaxDepthShift) {
+    throw Error(section.file() + ": key '" + section.qualified("depth_registration_shift_px") +
+                "' must be two whole pixel offsets [dx, dy], each within +-" +
+                std::to_string(kMaxDepthShift));
+  }
+  camera.depth_shift_x = shift[0];
+  camera.depth_shift_y = shift[1];
   require_positive(p.width, section, "width");
   require_positive(p.height, section, "height");
   require_positive(p.fx, section, "fx");
@@ -114,6 +125,10 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "depth_noise" << YAML::Value
       << (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1 ? "kinect_v1" : "none");
   out << YAML::Key << "depth_noise_scale" << YAML::Value << config.camera.depth_noise_scale;
+  if (config.camera.depth_shift_x != 0 || config.camera.depth_shift_y != 0) {
+    out << YAML::Key << "depth_registration_shift_px" << YAML::Value << YAML::Flow
+        << std::vector<int>{config.camera.depth_shift_x, config.camera.depth_shift_y};
+  }
   out << YAML::EndMap;
   out << YAML::Key << "orb" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "n_features" << YAML::Value << config.orb.n_features;

@@ -23,6 +23,12 @@ struct CameraConfig {
   enum class DepthNoise { none, kinect_v1 };
   DepthNoise depth_noise = DepthNoise::none;
   double depth_noise_scale = 2.0;
+  // Residual misregistration of a depth image that the sensor registered to the colour image
+  // (optional key `depth_registration_shift_px: [dx, dy]`): the depth of colour pixel (u, v) is
+  // read at depth pixel (u + dx, v + dy). Measured per sensor by
+  // tools/calibration/depth_registration_shift.py (edge alignment); 0, 0 = registered exactly.
+  int depth_shift_x = 0;
+  int depth_shift_y = 0;
 };
 
 // ORB extractor parameters as ORB-SLAM2 defines them (YAML section `orb:`, all optional).

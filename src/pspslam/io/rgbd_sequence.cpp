@@ -83,7 +83,8 @@ std::string describe_type(const cv::Mat& image) {
 
 }  // namespace
 
-cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor) {
+cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor, int shift_x,
+                         int shift_y) {
   const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
   if (raw.empty()) {
     throw Error(file.string() + ": cannot read depth image (missing, empty or not an image)");
@@ -93,7 +94,18 @@ cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor)
                 describe_type(raw) + ")");
   }
   cv::Mat metres;
-  raw.convertTo(metres, CV_32F, 1.0 / depth_factor);
+  if (shift_x == 0 && shift_y == 0) {
+    raw.convertTo(metres, CV_32F, 1.0 / depth_factor);
+    return metres;
+  }
+  // One conversion of the overlapping rectangle into place; the strip shifted in stays 0.
+  metres = cv::Mat::zeros(raw.size(), CV_32F);
+  const cv::Rect image(0, 0, raw.cols, raw.rows);
+  const cv::Rect source = image & (image + cv::Point(shift_x, shift_y));
+  if (!source.empty()) {
+    cv::Mat target = metres(source - cv::Point(shift_x, shift_y));
+    raw(source).convertTo(target, CV_32F, 1.0 / depth_factor);
+  }
   return metres;
 }
 
@@ -207,7 +219,8 @@ RgbdFrame RgbdSequence::load(size_t i) const {
   const std::filesystem::path rgb_path = dir_ / files.rgb_file;
   const std::filesystem::path depth_path = dir_ / files.depth_file;
   frame.bgr = read_color_image(rgb_path);
-  frame.depth = read_depth_image(depth_path, options_.depth_factor);
+  frame.depth = read_depth_image(depth_path, options_.depth_factor, options_.depth_shift_x,
+                                 options_.depth_shift_y);
   if (frame.bgr.size() != frame.depth.size()) {
     throw Error(rgb_path.string() + " is " + std::to_string(frame.bgr.cols) + "x" +
                 std::to_string(frame.bgr.rows) + " but " + depth_path.string() + " is " +

@@ -17,6 +17,9 @@ namespace pspslam {
 struct SequenceOptions {
   // Depth image units per metre (5000 for TUM RGB-D and Bonn; take it from CameraConfig).
   double depth_factor = 5000.0;
+  // CameraConfig's depth registration shift: frame.depth(u, v) = depth image at (u + x, v + y).
+  int depth_shift_x = 0;
+  int depth_shift_y = 0;
   // Colour/depth association window, as associate.py's --max_difference.
   double max_difference = kDefaultMaxTimeDifference;
   // Where open() prints its one-line missing-files warning; nullptr keeps it silent (the text
@@ -101,10 +104,13 @@ class RgbdSequence {
   std::string warning_;
 };
 
-// Reads a 16-bit depth PNG as CV_32FC1 metres (value / depth_factor; 0 stays 0 = no reading).
+// Reads a 16-bit depth PNG as CV_32FC1 metres (value / depth_factor; 0 stays 0 = no reading),
+// shifted so that result(u, v) = image(u + shift_x, v + shift_y) (pixels shifted in from beyond
+// the border have no reading).
 // Errors: "<file>: cannot read depth image (missing, empty or not an image)",
 // "<file>: depth image must be 16-bit single-channel (got 8-bit, 1 channel)".
-cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor);
+cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor, int shift_x = 0,
+                         int shift_y = 0);
 
 // Reads a colour image (PNG, JPEG, ...) as CV_8UC3 BGR.
 cv::Mat read_color_image(const std::filesystem::path& file);

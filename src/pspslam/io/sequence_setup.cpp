@@ -26,6 +26,8 @@ SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
   SystemConfig config = load_config(config_path);
   SequenceOptions options;
   options.depth_factor = config.camera.depth_factor;
+  options.depth_shift_x = config.camera.depth_shift_x;
+  options.depth_shift_y = config.camera.depth_shift_y;
   options.warnings = warnings;
   return SequenceSetup{config_path, config, RgbdSequence::open(dir, options)};
 }
@@ -57,10 +59,14 @@ std::string describe_sequence(const SequenceSetup& setup) {
     out << "ground truth: no (no groundtruth.txt)\n";
   }
   const CameraConfig& camera = setup.config.camera;
-  std::snprintf(line, sizeof(line), "config:       %s (camera '%s', %dx%d, depth factor %g)\n",
+  std::snprintf(line, sizeof(line), "config:       %s (camera '%s', %dx%d, depth factor %g",
                 setup.config_file.string().c_str(), camera.name.c_str(), camera.pinhole.width,
                 camera.pinhole.height, camera.depth_factor);
   out << line;
+  if (camera.depth_shift_x != 0 || camera.depth_shift_y != 0)
+    out << ", depth registration shift " << camera.depth_shift_x << ", " << camera.depth_shift_y
+        << " px";
+  out << ")\n";
   return out.str();
 }
 

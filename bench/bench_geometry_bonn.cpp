@@ -36,6 +36,7 @@
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/trajectory_io.h"
 
 namespace {
@@ -128,7 +129,6 @@ int main(int argc, char** argv) {
         });
     if (std::abs(nearest->t - rgb[i].t) > 0.02 || !fs::exists(dir / nearest->file)) continue;
     const cv::Mat bgr = cv::imread((dir / rgb[i].file).string());
-    const cv::Mat raw = cv::imread((dir / nearest->file).string(), cv::IMREAD_ANYDEPTH);
     Frame f;
     f.timestamp = rgb[i].t;
     if (!poses.empty()) {
@@ -138,8 +138,10 @@ int main(int argc, char** argv) {
           });
       if (std::abs(pose->timestamp - rgb[i].t) < 0.005) f.T_world_camera = pose->T_world_camera;
     }
-    cv::Mat metres;
-    raw.convertTo(metres, CV_32F, 1.0 / config.camera.depth_factor);
+    // As System reads it: metres, with the config's depth registration shift.
+    const cv::Mat metres =
+        read_depth_image(dir / nearest->file, config.camera.depth_factor,
+                         config.camera.depth_shift_x, config.camera.depth_shift_y);
     // Nearest remap: never blends depths across an object edge.
     cv::remap(metres, f.depth, map_x, map_y, cv::INTER_NEAREST);
     cv::Mat gray;

@@ -47,8 +47,8 @@ constexpr int kInterruptedExit = 130;
 constexpr int kNeverStartedExit = 3;
 
 // Watches the frames before the first map. A sequence without depth readings never starts; the
-// user is told so (once, after `warn_after` such frames) with the best frame's
-// depth count, not left with an empty trajectory and no reason.
+// user is told so (once, after `warn_after` such frames) with the best frame's depth count, not
+// left with an empty trajectory and no reason.
 class StartWatch {
  public:
   explicit StartWatch(size_t warn_after) : warn_after_(warn_after) {}
@@ -654,7 +654,7 @@ int run_command(const std::vector<std::string>& args) {
               << " frames; trajectory.txt holds every pose computed so far\n";
     return kInterruptedExit;
   }
-  if (processed > 0 && trajectory.count() == 0 && start_watch.never_started()) {
+  if (start_watch.never_started()) {  // no frame got a pose, so the trajectory is empty
     std::cerr << "error: " << start_watch.reason() << "\n";
     return kNeverStartedExit;
   }

@@ -68,7 +68,7 @@ struct TrackResult {
   int num_keypoints = 0;
   int num_inliers = 0;  // map point matches after local map tracking
   // Frames before the map exists: keypoints with a depth reading, against the number the first
-  // map needs (so a caller can say why a sequence never starts, e.g. a wrong depth factor).
+  // map needs (so a caller can say why a sequence never starts, e.g. empty depth images).
   int keypoints_with_depth = 0;
   int keypoints_with_depth_needed = 0;
 };

@@ -8,7 +8,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -105,7 +107,7 @@ int count_pose_lines(const std::filesystem::path& file) {
 
 TEST(RunCommand, WritesEveryOutputForASyntheticSequence) {
   const std::filesystem::path dir = testing::make_temp_dir("run_cli");
-  SynthOptions options = static_room(30);
+  SynthOptions options = static_room(60);  // 60 frames: a few keyframes for local BA to move
   write_sequence(options, dir / "sequence");
   std::string output;
   const int status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
@@ -113,13 +115,35 @@ TEST(RunCommand, WritesEveryOutputForASyntheticSequence) {
                                             (dir / "out").string(),
                                         &output);
   ASSERT_EQ(status, 0) << output;
-  EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory.txt"), 30);
-  EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory_refined.txt"), 30);
+  EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory.txt"), 60);
+  EXPECT_EQ(count_pose_lines(dir / "out" / "trajectory_refined.txt"), 60);
   EXPECT_EQ(count_pose_lines(dir / "out" / "lost_frames.txt"), 0);
-  EXPECT_GE(count_pose_lines(dir / "out" / "keyframes.txt"), 1);
-  EXPECT_EQ(count_pose_lines(dir / "out" / "timing.csv"), 31);  // header + one row per frame
-  EXPECT_NE(output.find("30 processed, 30 tracked, 0 without pose"), std::string::npos) << output;
+  EXPECT_GE(count_pose_lines(dir / "out" / "keyframes.txt"), 2);
+  EXPECT_EQ(count_pose_lines(dir / "out" / "timing.csv"), 61);  // header + one row per frame
+  EXPECT_NE(output.find("60 processed, 60 tracked, 0 without pose"), std::string::npos) << output;
   EXPECT_NE(output.find("ATE trajectory.txt"), std::string::npos) << output;
+
+  // trajectory_refined.txt passes through every keyframe's final pose (refined_trajectory's
+  // interpolation nodes), and local BA did move some keyframe away from its tracked pose.
+  const Trajectory tracked = read_tum_trajectory(dir / "out" / "trajectory.txt");
+  const Trajectory refined = read_tum_trajectory(dir / "out" / "trajectory_refined.txt");
+  const Trajectory keyframes = read_tum_trajectory(dir / "out" / "keyframes.txt");
+  ASSERT_EQ(refined.size(), tracked.size());
+  double largest_keyframe_move = 0.0;
+  for (const StampedPose& keyframe : keyframes) {
+    const auto at = std::find_if(refined.begin(), refined.end(), [&](const StampedPose& p) {
+      return std::abs(p.timestamp - keyframe.timestamp) < 1e-6;
+    });
+    ASSERT_NE(at, refined.end()) << "keyframe " << keyframe.timestamp;
+    EXPECT_LT((at->T_world_camera.translation() - keyframe.T_world_camera.translation()).norm(),
+              1e-9);
+    EXPECT_TRUE(at->T_world_camera.linear().isApprox(keyframe.T_world_camera.linear(), 1e-9));
+    const StampedPose& as_tracked = tracked[static_cast<size_t>(at - refined.begin())];
+    largest_keyframe_move = std::max(
+        largest_keyframe_move,
+        (as_tracked.T_world_camera.translation() - keyframe.T_world_camera.translation()).norm());
+  }
+  EXPECT_GT(largest_keyframe_move, 1e-6);
 }
 
 TEST(RunCommand, RejectsANegativeFrameLimit) {

@@ -10,6 +10,7 @@
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 #include "pspslam/tracking/keyframe_sink.h"
+#include "pspslam/tracking/trajectory_refinement.h"
 
 namespace pspslam {
 const char* to_string(TrackingState state) {
@@ -111,7 +112,7 @@ TrackResult Tracker::track(Frame frame) {
     last_tracked_pose_ = frame.T_camera_world();
     anchors_.push_back({frame.timestamp(), reference_keyframe_,
                         frame.T_camera_world() * reference_keyframe_->T_world_camera(),
-                        frame.T_camera_world()});
+                        frame.T_camera_world(), result.keyframe_inserted});
   } else {
     velocity_.reset();
   }
@@ -124,16 +125,18 @@ TrackResult Tracker::track(Frame frame) {
 }
 
 Trajectory Tracker::refined_trajectory() const {
-  Trajectory trajectory;
-  trajectory.reserve(anchors_.size());
+  std::vector<TrackedFramePose> frames;
+  frames.reserve(anchors_.size());
   for (const FrameAnchor& anchor : anchors_) {
-    const auto reference = anchor.reference.lock();
-    const Pose T_camera_world = reference && !reference->is_bad()
-                                    ? anchor.T_camera_reference * reference->T_camera_world()
-                                    : anchor.T_camera_world;
-    trajectory.push_back({anchor.timestamp, T_camera_world.inverse()});
+    TrackedFramePose& frame = frames.emplace_back();
+    frame.timestamp = anchor.timestamp;
+    frame.T_world_camera_tracked = anchor.T_camera_world.inverse();
+    if (!anchor.became_keyframe) continue;
+    const auto keyframe = anchor.reference.lock();
+    if (keyframe && !keyframe->is_bad())
+      frame.T_world_camera_keyframe_now = keyframe->T_world_camera();
   }
-  return trajectory;
+  return refine_by_keyframe_corrections(frames);
 }
 
 void Tracker::on_map_corrected() {

@@ -92,10 +92,9 @@ class Tracker {
 
   TrackResult track(Frame frame);
 
-  // Every tracked frame's pose re-expressed through its reference keyframe as local mapping
-  // has refined it since (ORB-SLAM2's saved trajectory): T_camera_world = T_camera_reference *
-  // T_reference_world(now). Frames whose reference keyframe was culled keep their tracked pose.
-  // Lost frames are absent, as in track(). Call when local mapping is idle or stopped.
+  // Every tracked frame moved by the corrections mapping has since applied to the keyframes
+  // around it in time (refine_by_keyframe_corrections; culled keyframes give none). Lost frames
+  // are absent, as in track(). Call when local mapping is idle or stopped.
   Trajectory refined_trajectory() const;
 
   // Keyframe poses were corrected behind the tracker's back (loop closing, global BA): the last
@@ -146,7 +145,8 @@ class Tracker {
     Timestamp timestamp = 0.0;
     std::weak_ptr<KeyFrame> reference;
     Pose T_camera_reference;
-    Pose T_camera_world;  // as tracked
+    Pose T_camera_world;           // as tracked
+    bool became_keyframe = false;  // `reference` is the keyframe made from this frame
   };
   std::vector<FrameAnchor> anchors_;
 

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <optional>
+#include <span>
+
+#include "pspslam/core/types.h"
+
+namespace pspslam {
+
+// One tracked frame: its pose as tracking estimated it then, and, when the frame became a
+// keyframe that is still in the map, that keyframe's pose now (after local BA, loop closing and
+// global BA moved it).
+struct TrackedFramePose {
+  Timestamp timestamp = 0.0;
+  Pose T_world_camera_tracked = Pose::Identity();
+  std::optional<Pose> T_world_camera_keyframe_now;
+};
+
+// The final trajectory: every tracked frame moved by the correction that mapping applied to the
+// keyframes around it. A keyframe's correction is D = T_world_camera_now * T_world_camera_tracked⁻¹
+// (a world-frame motion); a frame between two keyframes gets D interpolated in time (rotation
+// slerp, translation linear), a frame before the first or after the last keyframe gets that
+// keyframe's D, and without any keyframe the tracked poses are returned unchanged.
+//
+// Why not ORB-SLAM2's T_camera_reference * T_reference_world(now): a frame's reference keyframe
+// is the one it shares most points with, often an older keyframe that BA had already moved
+// before the frame was tracked, so the frame inherits a correction it never needed. On
+// bonn_crowd_dev that made the saved trajectory worse than the tracked one (docs/benchmarks.md).
+// `frames` must be sorted by timestamp.
+Trajectory refine_by_keyframe_corrections(std::span<const TrackedFramePose> frames);
+
+}  // namespace pspslam

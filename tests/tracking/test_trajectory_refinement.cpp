@@ -25,7 +25,10 @@ double yaw_deg(const Pose& p) {
 std::vector<TrackedFramePose> straight_line() {
   std::vector<TrackedFramePose> frames;
   for (int i = 0; i < 5; ++i) {
-    frames.push_back({static_cast<double>(i), pose(10.0 * i, {0.5 * i, 0.0, 1.0}), std::nullopt});
+    TrackedFramePose& frame = frames.emplace_back();
+    frame.timestamp = static_cast<double>(i);
+    frame.T_world_camera_tracked = pose(10.0 * i, {0.5 * i, 0.0, 1.0});
+    frame.T_world_camera_through_reference = frame.T_world_camera_tracked;
   }
   return frames;
 }
@@ -33,14 +36,44 @@ std::vector<TrackedFramePose> straight_line() {
 const Pose kFirstCorrection = pose(0.0, {0.10, 0.0, 0.0});
 const Pose kSecondCorrection = pose(20.0, {0.30, -0.2, 0.0});
 
-TEST(TrajectoryRefinement, WithoutKeyframesTheTrackedPosesStay) {
-  const std::vector<TrackedFramePose> frames = straight_line();
+TEST(TrajectoryRefinement, WithoutKeyframesFramesGoThroughTheirReferenceKeyframes) {
+  std::vector<TrackedFramePose> frames = straight_line();
+  for (TrackedFramePose& frame : frames)
+    frame.T_world_camera_through_reference = kFirstCorrection * frame.T_world_camera_tracked;
   const Trajectory refined = refine_by_keyframe_corrections(frames);
   ASSERT_EQ(refined.size(), frames.size());
   for (size_t i = 0; i < frames.size(); ++i) {
     EXPECT_DOUBLE_EQ(refined[i].timestamp, frames[i].timestamp);
-    EXPECT_TRUE(refined[i].T_world_camera.isApprox(frames[i].T_world_camera_tracked, 1e-12));
+    EXPECT_TRUE(
+        refined[i].T_world_camera.isApprox(frames[i].T_world_camera_through_reference, 1e-12));
   }
+}
+
+TEST(TrajectoryRefinement, NeverInterpolatesAcrossAMapCorrection) {
+  // A loop correction between t = 2 and t = 3: frames 0-2 were tracked in the uncorrected map,
+  // frames 3-4 in the corrected one. Frame 2 takes the keyframe-1 correction alone.
+  std::vector<TrackedFramePose> frames = straight_line();
+  frames[3].map_epoch = frames[4].map_epoch = 1;
+  frames[1].T_world_camera_keyframe_now = kFirstCorrection * frames[1].T_world_camera_tracked;
+  frames[3].T_world_camera_keyframe_now = kSecondCorrection * frames[3].T_world_camera_tracked;
+  const Trajectory refined = refine_by_keyframe_corrections(frames);
+  ASSERT_EQ(refined.size(), 5u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(refined[i].T_world_camera.isApprox(
+        kFirstCorrection * frames[i].T_world_camera_tracked, 1e-12))
+        << "frame " << i;
+  }
+  for (size_t i = 3; i < 5; ++i) {
+    EXPECT_TRUE(refined[i].T_world_camera.isApprox(
+        kSecondCorrection * frames[i].T_world_camera_tracked, 1e-12))
+        << "frame " << i;
+  }
+  // An epoch whose keyframes were all culled: its frames go through their reference keyframes.
+  frames[3].T_world_camera_keyframe_now.reset();
+  frames[3].T_world_camera_through_reference = kSecondCorrection;
+  const Trajectory without = refine_by_keyframe_corrections(frames);
+  EXPECT_TRUE(without[3].T_world_camera.isApprox(kSecondCorrection, 1e-12));
+  EXPECT_TRUE(without[4].T_world_camera.isApprox(frames[4].T_world_camera_tracked, 1e-12));
 }
 
 TEST(TrajectoryRefinement, FramesFollowTheCorrectionsOfTheKeyframesAroundThem) {

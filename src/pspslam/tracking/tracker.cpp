@@ -112,7 +112,7 @@ TrackResult Tracker::track(Frame frame) {
     last_tracked_pose_ = frame.T_camera_world();
     anchors_.push_back({frame.timestamp(), reference_keyframe_,
                         frame.T_camera_world() * reference_keyframe_->T_world_camera(),
-                        frame.T_camera_world(), result.keyframe_inserted});
+                        frame.T_camera_world(), result.keyframe_inserted, map_epoch_});
   } else {
     velocity_.reset();
   }
@@ -131,15 +131,20 @@ Trajectory Tracker::refined_trajectory() const {
     TrackedFramePose& frame = frames.emplace_back();
     frame.timestamp = anchor.timestamp;
     frame.T_world_camera_tracked = anchor.T_camera_world.inverse();
-    if (!anchor.became_keyframe) continue;
-    const auto keyframe = anchor.reference.lock();
-    if (keyframe && !keyframe->is_bad())
-      frame.T_world_camera_keyframe_now = keyframe->T_world_camera();
+    frame.map_epoch = anchor.map_epoch;
+    const auto reference = anchor.reference.lock();
+    const bool reference_alive = reference && !reference->is_bad();
+    frame.T_world_camera_through_reference =
+        reference_alive ? (anchor.T_camera_reference * reference->T_camera_world()).inverse()
+                        : frame.T_world_camera_tracked;
+    if (anchor.became_keyframe && reference_alive)
+      frame.T_world_camera_keyframe_now = reference->T_world_camera();
   }
   return refine_by_keyframe_corrections(frames);
 }
 
 void Tracker::on_map_corrected() {
+  ++map_epoch_;
   if (anchors_.empty()) return;
   const FrameAnchor& anchor = anchors_.back();
   const auto reference = anchor.reference.lock();

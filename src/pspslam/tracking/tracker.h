@@ -93,8 +93,9 @@ class Tracker {
   TrackResult track(Frame frame);
 
   // Every tracked frame moved by the corrections mapping has since applied to the keyframes
-  // around it in time (refine_by_keyframe_corrections; culled keyframes give none). Lost frames
-  // are absent, as in track(). Call when local mapping is idle or stopped.
+  // around it in time, never across a loop correction or global BA
+  // (refine_by_keyframe_corrections; culled keyframes give none). Lost frames are absent, as in
+  // track(). Call when local mapping is idle or stopped.
   Trajectory refined_trajectory() const;
 
   // Keyframe poses were corrected behind the tracker's back (loop closing, global BA): the last
@@ -147,8 +148,10 @@ class Tracker {
     Pose T_camera_reference;
     Pose T_camera_world;           // as tracked
     bool became_keyframe = false;  // `reference` is the keyframe made from this frame
+    int map_epoch = 0;
   };
   std::vector<FrameAnchor> anchors_;
+  int map_epoch_ = 0;  // map corrections so far (on_map_corrected calls)
 
   // Reused per-frame buffers (no allocation per keypoint).
   FramePoseBuffers pose_buffers_;

@@ -14,19 +14,27 @@ struct TrackedFramePose {
   Timestamp timestamp = 0.0;
   Pose T_world_camera_tracked = Pose::Identity();
   std::optional<Pose> T_world_camera_keyframe_now;
+  // How many map corrections (loop closures, global BAs) had been applied when the frame was
+  // tracked. Frames on either side of a correction were tracked in differently corrected maps,
+  // so a correction is never interpolated across one.
+  int map_epoch = 0;
+  // The frame re-expressed through its reference keyframe (T_world_reference(now) *
+  // T_reference_camera as tracked): used for an epoch in which no keyframe survives.
+  Pose T_world_camera_through_reference = Pose::Identity();
 };
 
 // The final trajectory: every tracked frame moved by the correction that mapping applied to the
 // keyframes around it. A keyframe's correction is D = T_world_camera_now * T_world_camera_tracked⁻¹
-// (a world-frame motion); a frame between two keyframes gets D interpolated in time (rotation
-// slerp, translation linear), a frame before the first or after the last keyframe gets that
-// keyframe's D, and without any keyframe the tracked poses are returned unchanged.
+// (a world-frame motion); a frame between two keyframes of its map epoch gets D interpolated in
+// time (rotation slerp, translation linear), a frame before the first or after the last
+// keyframe of its epoch gets that keyframe's D, and a frame of an epoch without keyframes its
+// pose through its reference keyframe.
 //
 // Why not ORB-SLAM2's T_camera_reference * T_reference_world(now): a frame's reference keyframe
 // is the one it shares most points with, often an older keyframe that BA had already moved
 // before the frame was tracked, so the frame inherits a correction it never needed. On
 // bonn_crowd_dev that made the saved trajectory worse than the tracked one (docs/benchmarks.md).
-// `frames` must be sorted by timestamp.
+// `frames` must be sorted by timestamp (and so by epoch).
 Trajectory refine_by_keyframe_corrections(std::span<const TrackedFramePose> frames);
 
 }  // namespace pspslam

@@ -7,8 +7,8 @@
 # trajectory for 1.5 turns (--loop-turns 1.5): one full turn, then half a turn over the
 # start again, long enough for ORB-SLAM2's covisibility consistency (3 consecutive keyframes).
 #
-# Reported: ATE RMSE of trajectory_refined.txt (every frame re-expressed through its reference
-# keyframe after loop correction and global BA: ORB-SLAM2's saved trajectory) and of
+# Reported: ATE RMSE of trajectory_refined.txt (every frame moved with the keyframes around it
+# after loop correction and global BA: the final trajectory) and of
 # trajectory.txt (poses as tracked online; a correction cannot change frames already written).
 # Medians over RUNS runs per cell. `uptime` is logged with every run (shared machine).
 #

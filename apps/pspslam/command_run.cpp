@@ -3,8 +3,8 @@
 //                    interrupted run leaves a valid file
 //   lost_frames.txt  timestamps of frames that got no pose (not initialised yet or lost)
 //   keyframes.txt    keyframe poses at the end (after local mapping)
-//   trajectory_refined.txt  the frames of trajectory.txt re-expressed through their reference
-//                    keyframes after local BA (ORB-SLAM2's saved trajectory), written at the end
+//   trajectory_refined.txt  the final trajectory, written at the end: the frames of
+//                    trajectory.txt moved with the BA-refined keyframes around them in time
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
 //                    dynamic-scene stages (mask age, geometry time, masked keypoints)
 //   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,

@@ -30,10 +30,12 @@ struct TrackedFramePose {
 // keyframe of its epoch gets that keyframe's D, and a frame of an epoch without keyframes its
 // pose through its reference keyframe.
 //
-// Why not ORB-SLAM2's T_camera_reference * T_reference_world(now): a frame's reference keyframe
-// is the one it shares most points with, often an older keyframe that BA had already moved
-// before the frame was tracked, so the frame inherits a correction it never needed. On
-// bonn_crowd_dev that made the saved trajectory worse than the tracked one (docs/benchmarks.md).
+// Why not ORB-SLAM2's T_camera_reference * T_reference_world(now): that moves a frame only by
+// what its reference keyframe moved after the frame was tracked. Tracking errors of consecutive
+// frames are correlated (motion model, the same map points), so the whole correction BA applied
+// to a keyframe since it was tracked is the better estimate of its neighbours' errors. On
+// bonn_crowd_dev the reference-keyframe trajectory was worse than the tracked one; this one is
+// better (docs/benchmarks.md).
 // `frames` must be sorted by timestamp (and so by epoch).
 Trajectory refine_by_keyframe_corrections(std::span<const TrackedFramePose> frames);
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Splits a trajectory's ATE into what a smoother would remove and what it would not.
 
-usage: bench/trajectory_error_bands.py GROUNDTRUTH ESTIMATE [--window 9]
+usage: bench/trajectory_error_bands.py GROUNDTRUTH ESTIMATE [--window 9] [--stamps FILE]
+                                      [--stretch N]
 
 After the SE(3) alignment of `pspslam eval` (nearest ground-truth pose within 20 ms, positions
 only), the per-frame error e_i is split into its moving average over --window frames
@@ -11,6 +12,9 @@ association moves the ground truth from its interpolation at the estimate's stam
 marker-to-camera lever arm would explain: the ATE after also fitting a fixed offset l in the
 camera frame (gt_i ~ R (p_i + R_i l) + t). Used in docs/benchmarks.md to say where bonn_crowd_dev's
 error comes from; it is a diagnosis, not a metric (the lever arm is fitted to the ground truth).
+--stamps FILE keeps only the estimate's poses at FILE's timestamps (e.g. a run's keyframes.txt, to
+compare the tracked poses of the keyframe frames with the final keyframe poses); --stretch N also
+prints the ATE RMSE of every N consecutive poses (N = 1: every pose), from the one alignment.
 Needs Debian's python3-numpy (`scripts/install-deps --train` installs it).
 """
 import argparse
@@ -53,8 +57,13 @@ def main():
     parser.add_argument("groundtruth")
     parser.add_argument("estimate")
     parser.add_argument("--window", type=int, default=9)
+    parser.add_argument("--stamps", help="evaluate only at the timestamps of this trajectory file")
+    parser.add_argument("--stretch", type=int, default=0, help="also print the RMSE per N poses")
     args = parser.parse_args()
     gt, est = load(args.groundtruth), load(args.estimate)
+    if args.stamps:
+        stamps = load(args.stamps)[:, 0]
+        est = est[[np.min(np.abs(stamps - t)) < 1e-4 for t in est[:, 0]]]
     nearest = np.array([np.argmin(np.abs(gt[:, 0] - t)) for t in est[:, 0]])
     keep = np.abs(gt[nearest, 0] - est[:, 0]) < 0.02
     # What nearest-stamp association costs: the matched ground-truth positions against the ground
@@ -69,6 +78,12 @@ def main():
     inner = slice(w, len(error) - w)  # the average is biased where the window leaves the ends
     low = moving_average(error, w)
     print(f"poses {len(error)}, ATE RMSE {rms(error):.1f} mm")
+    for first in range(0, len(error), args.stretch or len(error)):
+        if not args.stretch:
+            break
+        last = min(first + args.stretch, len(error)) - 1
+        print(f"  poses {first}-{last} (t = {est[first, 0] - est[0, 0]:.2f}-"
+              f"{est[last, 0] - est[0, 0]:.2f} s): {rms(error[first:last + 1]):.1f} mm")
     print(f"low-frequency ({w}-frame average) {rms(low[inner]):.1f} mm, "
           f"high-frequency {rms((error - low)[inner]):.1f} mm")
     print(f"ground truth's own high-frequency part {rms((g - moving_average(g, w))[inner]):.1f} mm; "

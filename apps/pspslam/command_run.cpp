@@ -10,11 +10,15 @@
 //   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,
 //                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)
+#include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -25,15 +29,17 @@
 #include <vector>
 
 #include "commands.h"
-#include "pspslam/core/arg_parser.h"
+#include "flag_checks.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
+#include "pspslam/core/output_paths.h"
 #include "pspslam/core/progress.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/map/map.h"
+#include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/system/map_export.h"
 #include "pspslam/system/system.h"
@@ -58,7 +64,7 @@ class StartWatch {
     if (started_ || result.keypoints_with_depth_needed == 0) return;
     best_ = std::max(best_, result.keypoints_with_depth);
     needed_ = result.keypoints_with_depth_needed;
-    if (++waiting_ == warn_after_) std::cerr << "warning: " << reason() << "\n";
+    if (++waiting_ == warn_after_) spdlog::warn("{}", reason());
   }
   bool never_started() const { return !started_ && waiting_ > 0; }
   std::string reason() const {
@@ -104,12 +110,8 @@ TimingSummary summarize(std::vector<double> values) {
   return summary;
 }
 
-std::string json_timing(const TimingSummary& t) {
-  char text[160];
-  std::snprintf(text, sizeof(text),
-                "{\"median\": %.3f, \"mean\": %.3f, \"p95\": %.3f, \"count\": %zu}", t.median,
-                t.mean, t.p95, t.count);
-  return text;
+nlohmann::ordered_json to_json(const TimingSummary& t) {
+  return {{"median", t.median}, {"mean", t.mean}, {"p95", t.p95}, {"count", t.count}};
 }
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
@@ -131,15 +133,13 @@ DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::pa
         ".onnx),\n  or pass a teacher, e.g. --model models/teachers/deeplabv3_mnv2_pascal.yaml "
         "(ONNX in ../shared/models)";
     if (!automatic || explicit_model) throw Error("--dynamic " + flag_value + ": " + how);
-    std::cerr << "warning: " << how << "\n  falling back to --dynamic geometry\n";
+    spdlog::warn("{}\n  falling back to --dynamic geometry", how);
     return DynamicMode::geometry;
   }
 }
 
 // `--loop-closing on|off|auto`: auto = on when the vocabulary file exists.
 bool parse_loop_closing(const std::string& value, const std::filesystem::path& vocabulary) {
-  if (value != "on" && value != "off" && value != "auto")
-    throw Error("--loop-closing expects on, off or auto, got '" + value + "'");
   return value == "on" || (value == "auto" && std::filesystem::exists(vocabulary));
 }
 
@@ -188,106 +188,87 @@ std::ofstream open_output(const std::filesystem::path& file) {
 }
 
 // --export-map / --export-dense, after shutdown (local mapping has refined the poses).
-void write_map_exports(const ArgParser& parser, const MapExporter& exporter, const Map& map) {
+void write_map_exports(const std::string& map_file, const std::string& dense_file,
+                       const MapExporter& exporter, const Map& map) {
   const std::vector<std::string> comment = {"pspslam static map, world frame (metres)"};
-  for (const char* flag : {"export-map", "export-dense"}) {
-    if (!parser.has(flag)) continue;
-    const std::filesystem::path file = parser.get(flag);
-    const std::vector<ColoredPoint> cloud = std::string(flag) == "export-map"
-                                                ? exporter.map_points(map)
-                                                : exporter.dense_cloud(map, DenseCloudOptions{});
-    write_point_cloud_ply(file, cloud, comment);
-    std::cout << "map export:   " << file.string() << " (" << cloud.size() << " points"
-              << (std::string(flag) == "export-dense"
-                      ? ", from " + std::to_string(exporter.remembered_keyframes()) +
-                            " keyframe images"
-                      : std::string())
-              << ")\n";
+  if (!map_file.empty()) {
+    const std::vector<ColoredPoint> cloud = exporter.map_points(map);
+    write_point_cloud_ply(map_file, cloud, comment);
+    std::cout << "map export:   " << map_file << " (" << cloud.size() << " points)\n";
+  }
+  if (!dense_file.empty()) {
+    const std::vector<ColoredPoint> cloud = exporter.dense_cloud(map, DenseCloudOptions{});
+    write_point_cloud_ply(dense_file, cloud, comment);
+    std::cout << "map export:   " << dense_file << " (" << cloud.size() << " points, from "
+              << exporter.remembered_keyframes() << " keyframe images)\n";
   }
 }
 
 }  // namespace
 
-int run_command(const std::vector<std::string>& args) {
-  ArgParser parser("pspslam run",
-                   "Runs SLAM on an RGB-D sequence in TUM layout (rgb.txt, depth.txt or "
-                   "associations.txt,\noptional groundtruth.txt) and writes OUT/trajectory.txt "
-                   "(every tracked frame),\nOUT/lost_frames.txt, OUT/keyframes.txt and "
-                   "OUT/timing.csv. With ground truth, prints ATE.");
-  parser.add_option("sequence", "sequence folder", "", true);
-  parser.add_option("config",
-                    "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
-                    "else required; presets in config/)");
-  parser.add_option("out", "output folder", "pspslam_out");
-  parser.add_option("max-frames", "process at most this many frames (0 = all)", "0");
-  parser.add_switch("no-local-mapping",
-                    "track only: keyframes enter the map but are never refined (debugging)");
-  parser.add_option("dynamic",
-                    "dynamic-scene mode: off | semantic | geometry | full | exhaustive | auto "
-                    "(auto = full when the segmentation model loads, else geometry)",
-                    "auto");
-  parser.add_option("model", "segmentation metadata YAML (relative: to the source directory)",
-                    "models/pspnet/pspnet.yaml");
-  parser.add_switch("realtime",
-                    "feed frames at the sequence's rate (late frames are dropped) and never wait "
-                    "for segmentation or local mapping: use the newest mask, warped into the frame "
-                    "(default: deterministic, each frame waits for its mask and for local "
-                    "mapping to finish the previous keyframe)");
-  parser.add_option("mask-margin", "dilation of the semantic dynamic mask (pixels)", "5");
-  std::ostringstream default_keyframe_ratio;
-  default_keyframe_ratio << KeyFramePolicyOptions{}.tracked_ratio_to_reference;
-  parser.add_option("keyframe-ratio",
-                    "a frame becomes a keyframe when it tracks fewer than this share of its "
-                    "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)",
-                    default_keyframe_ratio.str());
-  parser.add_option("vocabulary",
-                    "ORB bag-of-words vocabulary for relocalisation (relative: to the source "
-                    "directory)",
-                    "models/vocabulary/orb_k10_l5.pspvoc");
-  parser.add_switch("no-relocalization",
-                    "do not relocalise when tracking is lost (and do not load the vocabulary)");
-  parser.add_option("loop-closing",
-                    "on | off | auto: loop closing thread (detection, essential-graph correction, "
-                    "global BA); auto = on when the vocabulary file exists",
-                    "auto");
-  parser.add_option("save-map",
-                    "write the final map to this file (binary, see docs/place_recognition.md)");
-  parser.add_option("load-map", "start from this saved map: the first frame is relocalised in it");
-  parser.add_switch("localization",
-                    "localisation only (needs --load-map): track in the map, never add to it");
-  parser.add_option("blackout",
-                    "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
-                    "(tracking is lost for real; tests relocalisation)");
-  parser.add_option("cull-hits",
-                    "erase a map point after it lay on dynamic pixels in this many frames", "3");
-  parser.add_option("export-map",
-                    "write the final static map points as a PLY point cloud (dynamic points never "
-                    "enter the map or are culled from it)");
-  parser.add_option(
-      "export-dense",
-      "also write a dense PLY cloud back-projected from the keyframes' depth at their "
-      "final poses, dynamic pixels left out (1 cm voxels, every 4th pixel)");
-  if (!parser.parse(args)) return 0;
-  const int max_frames_flag = parser.get_int("max-frames");
+struct RunFlags {
+  std::string sequence;
+  std::string config;
+  std::string out = "pspslam_out";
+  size_t max_frames = 0;
+  bool no_local_mapping = false;
+  std::string dynamic = "auto";
+  std::string model;  // empty: the shipped model
+  bool realtime = false;
+  int mask_margin = 5;
+  double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
+  std::string vocabulary;  // empty: the shipped vocabulary
+  bool no_relocalization = false;
+  std::string loop_closing = "auto";
+  std::string save_map;
+  std::string load_map;
+  bool localization = false;
+  std::string blackout;
+  int cull_hits = 3;
+  std::string export_map;
+  std::string export_dense;
+};
+
+// A path the user typed is relative to the current folder; only the built-in defaults are found
+// next to the program.
+std::filesystem::path user_or_default(const std::string& typed,
+                                      const std::filesystem::path& shipped) {
+  return typed.empty() ? shipped : std::filesystem::path(typed);
+}
+
+int run_slam(const RunFlags& flags, const GlobalOptions& global) {
+  const size_t max_frames_flag = flags.max_frames;
   // Assigned, not built by a conditional expression: GCC 12 then reports a false
   // "maybe-uninitialized" on blackout->end() under -Werror.
   std::optional<Blackout> blackout;
-  if (parser.has("blackout")) blackout = parse_blackout(parser.get("blackout"));
-  if (max_frames_flag < 0)
-    throw Error("--max-frames must be >= 0, got " + parser.get("max-frames"));
+  if (!flags.blackout.empty()) blackout = parse_blackout(flags.blackout);
+
+  // Every output path is checked (and its folder created) before any work, so a run never
+  // computes for minutes and then fails to write.
+  const std::filesystem::path out_dir = flags.out;
+  prepare_output_folder(out_dir, "--out");
+  const std::pair<const char*, const std::string*> output_files[] = {
+      {"--save-map", &flags.save_map},
+      {"--export-map", &flags.export_map},
+      {"--export-dense", &flags.export_dense}};
+  for (const auto& [flag, file] : output_files) {
+    if (!file->empty()) prepare_output_file(*file, flag);
+  }
+
+  SystemOptions system_options;
+  DynamicOptions& dynamic = system_options.dynamic;
+  dynamic.model = user_or_default(flags.model, source_dir() / "models/pspnet/pspnet.yaml");
+  dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
 
   const std::optional<std::filesystem::path> config =
-      parser.has("config") ? std::optional<std::filesystem::path>(parser.get("config"))
-                           : std::nullopt;
-  const SequenceSetup setup = open_sequence_with_config(parser.get("sequence"), config, &std::cerr);
+      !flags.config.empty() ? std::optional<std::filesystem::path>(flags.config) : std::nullopt;
+  const SequenceSetup setup = open_sequence_with_config(
+      flags.sequence, config, spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr);
   const RgbdSequence& sequence = setup.sequence;
   const PinholeCamera& camera = setup.config.camera.pinhole;
-  const size_t frames = max_frames_flag == 0
-                            ? sequence.size()
-                            : std::min(sequence.size(), static_cast<size_t>(max_frames_flag));
+  const size_t frames =
+      max_frames_flag == 0 ? sequence.size() : std::min(sequence.size(), max_frames_flag);
 
-  const std::filesystem::path out_dir = parser.get("out");
-  std::filesystem::create_directories(out_dir);
   TrajectoryWriter trajectory(out_dir / "trajectory.txt");
   std::ofstream lost = open_output(out_dir / "lost_frames.txt");
   lost << "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
@@ -297,49 +278,33 @@ int run_command(const std::vector<std::string>& args) {
             "mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points\n";
   std::cout << describe_sequence(setup);
 
-  SystemOptions system_options;
-  system_options.local_mapping = !parser.flag("no-local-mapping");
-  system_options.synchronous_local_mapping = !parser.flag("realtime");
-  double& keyframe_ratio = system_options.tracker.keyframes.tracked_ratio_to_reference;
-  keyframe_ratio = parser.get_double("keyframe-ratio");
-  if (!(keyframe_ratio > 0.0 && keyframe_ratio <= 1.0))
-    throw Error("--keyframe-ratio must be in (0, 1], got " + parser.get("keyframe-ratio"));
-  DynamicOptions& dynamic = system_options.dynamic;
-  dynamic.model = parser.get("model");
-  if (dynamic.model.is_relative()) dynamic.model = source_dir() / dynamic.model;
-  dynamic.mode = choose_mode(parser.get("dynamic"), dynamic.model, parser.has("model"));
-  dynamic.realtime = parser.flag("realtime");
-  dynamic.semantic.mask_dilation_px = parser.get_int("mask-margin");
-  if (dynamic.semantic.mask_dilation_px < 0)
-    throw Error("--mask-margin must be >= 0, got " + parser.get("mask-margin"));
-  dynamic.culling.min_dynamic_hits = parser.get_int("cull-hits");
-  if (dynamic.culling.min_dynamic_hits < 1)
-    throw Error("--cull-hits must be >= 1, got " + parser.get("cull-hits"));
+  system_options.local_mapping = !flags.no_local_mapping;
+  system_options.synchronous_local_mapping = !flags.realtime;
+  system_options.tracker.keyframes.tracked_ratio_to_reference = flags.keyframe_ratio;
+  dynamic.realtime = flags.realtime;
+  dynamic.semantic.mask_dilation_px = flags.mask_margin;
+  dynamic.culling.min_dynamic_hits = flags.cull_hits;
   std::cout << "dynamic:      " << to_string(dynamic.mode)
             << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
             << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
             << "\n";
-  system_options.place.relocalization = !parser.flag("no-relocalization");
-  if (parser.flag("localization") && !parser.has("load-map"))
-    throw Error("--localization needs --load-map FILE (a map to localise in)");
-  if (parser.has("load-map")) {
-    system_options.map_file = parser.get("load-map");
-    system_options.localization_only = parser.flag("localization");
+  system_options.place.relocalization = !flags.no_relocalization;
+  if (!flags.load_map.empty()) {
+    system_options.map_file = flags.load_map;
+    system_options.localization_only = flags.localization;
     std::cout << "map:          " << system_options.map_file.string()
               << (system_options.localization_only ? " (localisation only)" : " (extended)")
               << "\n";
   }
-  system_options.place.vocabulary = parser.get("vocabulary");
-  if (system_options.place.vocabulary.is_relative())
-    system_options.place.vocabulary = source_dir() / system_options.place.vocabulary;
+  system_options.place.vocabulary = user_or_default(flags.vocabulary, default_vocabulary_path());
   system_options.place.loop_closing =
-      parse_loop_closing(parser.get("loop-closing"), system_options.place.vocabulary);
+      parse_loop_closing(flags.loop_closing, system_options.place.vocabulary);
   std::cout << "loop closing: " << (system_options.place.loop_closing ? "on" : "off") << "\n";
   System system(setup.config, system_options);
   std::optional<MapExporter> exporter;
-  if (parser.has("export-map") || parser.has("export-dense")) exporter.emplace(camera);
+  if (!flags.export_map.empty() || !flags.export_dense.empty()) exporter.emplace(camera);
   InterruptGuard interrupt_guard;
-  ProgressBar progress("slam", frames, std::cerr);
+  ProgressBar progress("slam", frames, std::cerr, !global.quiet);
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;
   std::vector<double> tracking_cpu_ms;
@@ -407,6 +372,13 @@ int run_command(const std::vector<std::string>& args) {
     }
     const FrameReport report = system.process(frame);
     const TrackResult& result = report.tracking;
+    spdlog::debug(
+        "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "
+        "{} dynamic",
+        i, frame.timestamp, to_string(result.state), to_string(result.method), result.num_inliers,
+        result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
+        report.dynamic.masked_keypoints, report.dynamic.tested_points,
+        report.dynamic.dynamic_points);
     if (exporter && result.keyframe_inserted)
       exporter->remember_keyframe(system.map().max_keyframe_id(), frame.bgr, frame.depth,
                                   system.last_dynamic_mask());
@@ -473,8 +445,8 @@ int run_command(const std::vector<std::string>& args) {
   }
   progress.finish();
   system.shutdown();
-  if (parser.has("save-map")) {
-    const std::filesystem::path map_file = parser.get("save-map");
+  if (!flags.save_map.empty()) {
+    const std::filesystem::path map_file = flags.save_map;
     const auto [saved_keyframes, saved_points] = system.save_map(map_file);
     std::cout << "map saved:    " << map_file.string() << " (" << saved_keyframes << " keyframes, "
               << saved_points << " map points, " << std::filesystem::file_size(map_file) / 1024
@@ -486,7 +458,7 @@ int run_command(const std::vector<std::string>& args) {
   const Trajectory refined = system.refined_trajectory();
   write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
   const MappingStats mapping = system.mapping_stats();
-  if (exporter) write_map_exports(parser, *exporter, system.map());
+  if (exporter) write_map_exports(flags.export_map, flags.export_dense, *exporter, system.map());
 
   char line[512];
   std::snprintf(line, sizeof(line),
@@ -535,7 +507,7 @@ int run_command(const std::vector<std::string>& args) {
   // Blackout: how soon a pose came back, and how good the poses after the return are (errors
   // of the whole run's alignment, restricted to frames from the return on).
   std::optional<ErrorStats> after_return;
-  std::string blackout_json;  // a stats.json member, empty without --blackout
+  nlohmann::ordered_json blackout_json;  // a stats.json member, null without --blackout
   if (blackout) {
     std::snprintf(line, sizeof(line), "blackout:     frames %zu-%zu black, %zu relocalisations; ",
                   blackout->first, blackout->end() - 1, relocalisations);
@@ -562,15 +534,14 @@ int run_command(const std::vector<std::string>& args) {
         std::cout << line;
       }
     }
-    std::snprintf(
-        line, sizeof(line),
-        "  \"blackout\": {\"first\": %zu, \"count\": %zu, \"frames_to_first_pose\": "
-        "%ld, \"after_return_rmse_m\": %.5f, \"after_return_max_m\": %.5f},\n",
-        blackout->first, blackout->count,
-        first_pose_after_blackout ? static_cast<long>(*first_pose_after_blackout - blackout->end())
-                                  : -1L,
-        after_return ? after_return->rmse : -1.0, after_return ? after_return->max : -1.0);
-    blackout_json = line;
+    blackout_json = {
+        {"first", blackout->first},
+        {"count", blackout->count},
+        {"frames_to_first_pose",
+         first_pose_after_blackout ? static_cast<long>(*first_pose_after_blackout - blackout->end())
+                                   : -1L},
+        {"after_return_rmse_m", after_return ? after_return->rmse : -1.0},
+        {"after_return_max_m", after_return ? after_return->max : -1.0}};
   }
 
   // Per-module timing and the dynamic-feature totals, printed and written to stats.json.
@@ -605,48 +576,47 @@ int run_command(const std::vector<std::string>& args) {
   std::cout << line;
 
   {
-    std::ofstream json = open_output(out_dir / "stats.json");
     const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
-    json << "{\n  \"sequence\": \"" << sequence.directory().string() << "\",\n"
-         << "  \"mode\": \"" << to_string(dynamic.mode) << "\",\n"
-         << "  \"realtime\": " << (dynamic.realtime ? "true" : "false") << ",\n"
-         << "  \"interrupted\": " << (interrupted() ? "true" : "false") << ",\n"
-         << "  \"frames\": " << processed << ",\n"
-         << "  \"lost_frames\": " << lost_count << ",\n"
-         << "  \"relocalisations\": " << relocalisations << ",\n"
-         << blackout_json << "  \"realtime_dropped_frames\": " << realtime_dropped << ",\n"
-         << "  \"seconds\": " << seconds << ",\n"
-         << "  \"fps\": " << fps << ",\n"
-         << "  \"timing_ms\": {\n"
-         << "    \"extraction\": " << json_timing(t_extraction) << ",\n"
-         << "    \"semantic\": " << json_timing(t_semantic) << ",\n"
-         << "    \"semantic_wait\": " << json_timing(t_semantic_wait) << ",\n"
-         << "    \"geometry\": " << json_timing(t_geometry) << ",\n"
-         << "    \"geometry_search\": " << json_timing(t_search) << ",\n"
-         << "    \"flow_homography\": " << json_timing(t_flow) << ",\n"
-         << "    \"tracking\": " << json_timing(t_tracking) << ",\n"
-         << "    \"local_mapping\": " << json_timing(t_mapping) << "\n  },\n"
-         << "  \"dynamic\": {\"tested_points\": " << tested_points
-         << ", \"dynamic_points\": " << dynamic_points
-         << ", \"masked_keypoints\": " << masked_keypoints
-         << ", \"culled_map_points\": " << culled_points
-         << ", \"frames_without_mask\": " << frames_without_mask << "},\n"
-         << "  \"mask_latency\": {\"frames\": " << json_timing(mask_age)
-         << ", \"ms\": " << json_timing(mask_latency) << "},\n"
-         << "  \"map\": {\"keyframes\": " << mapping.keyframes_in_map
-         << ", \"map_points\": " << mapping.map_points << "},\n"
-         << "  \"loops\": {\"enabled\": " << (system_options.place.loop_closing ? "true" : "false")
-         << ", \"closed\": " << mapping.loops_closed
-         << ", \"global_ba_applied\": " << mapping.global_ba_applied << "}";
+    nlohmann::ordered_json stats = {{"sequence", sequence.directory().string()},
+                                    {"mode", to_string(dynamic.mode)},
+                                    {"realtime", dynamic.realtime},
+                                    {"interrupted", interrupted()},
+                                    {"frames", processed},
+                                    {"lost_frames", lost_count},
+                                    {"relocalisations", relocalisations}};
+    if (!blackout_json.is_null()) stats["blackout"] = blackout_json;
+    stats["realtime_dropped_frames"] = realtime_dropped;
+    stats["seconds"] = seconds;
+    stats["fps"] = fps;
+    stats["timing_ms"] = {
+        {"extraction", to_json(t_extraction)},       {"semantic", to_json(t_semantic)},
+        {"semantic_wait", to_json(t_semantic_wait)}, {"geometry", to_json(t_geometry)},
+        {"geometry_search", to_json(t_search)},      {"flow_homography", to_json(t_flow)},
+        {"tracking", to_json(t_tracking)},           {"local_mapping", to_json(t_mapping)}};
+    stats["dynamic"] = {{"tested_points", tested_points},
+                        {"dynamic_points", dynamic_points},
+                        {"masked_keypoints", masked_keypoints},
+                        {"culled_map_points", culled_points},
+                        {"frames_without_mask", frames_without_mask}};
+    stats["mask_latency"] = {{"frames", to_json(mask_age)}, {"ms", to_json(mask_latency)}};
+    stats["map"] = {{"keyframes", mapping.keyframes_in_map}, {"map_points", mapping.map_points}};
+    stats["loops"] = {{"enabled", system_options.place.loop_closing},
+                      {"closed", mapping.loops_closed},
+                      {"global_ba_applied", mapping.global_ba_applied}};
     const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
         {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
     for (const auto& [key, ate] : ates) {
       if (!*ate) continue;
-      json << ",\n  \"" << key << "\": {\"rmse\": " << (*ate)->error.rmse
-           << ", \"mean\": " << (*ate)->error.mean << ", \"median\": " << (*ate)->error.median
-           << ", \"max\": " << (*ate)->error.max << ", \"poses\": " << (*ate)->error.count << "}";
+      stats[key] = {{"rmse", (*ate)->error.rmse},
+                    {"mean", (*ate)->error.mean},
+                    {"median", (*ate)->error.median},
+                    {"max", (*ate)->error.max},
+                    {"poses", (*ate)->error.count}};
     }
-    json << "\n}\n";
+    std::ofstream json = open_output(out_dir / "stats.json");
+    // Paths are not always UTF-8 (a Latin-1 folder name); replace invalid bytes instead of
+    // throwing, so the summary is always written.
+    json << stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   }
   std::cout << "stats:        " << (out_dir / "stats.json").string() << "\n";
   if (interrupted()) {
@@ -655,10 +625,95 @@ int run_command(const std::vector<std::string>& args) {
     return kInterruptedExit;
   }
   if (start_watch.never_started()) {  // no frame got a pose, so the trajectory is empty
-    std::cerr << "error: " << start_watch.reason() << "\n";
+    spdlog::error("{}", start_watch.reason());
     return kNeverStartedExit;
   }
   return 0;
+}
+
+Command add_run_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "run",
+      "run SLAM on an RGB-D sequence and write the trajectory.\n"
+      "Reads a sequence in TUM layout (rgb.txt, depth.txt or associations.txt, optional "
+      "groundtruth.txt)\nand writes OUT/trajectory.txt (every tracked frame), "
+      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv and "
+      "OUT/stats.json. With ground truth, prints ATE.");
+  auto flags = std::make_shared<RunFlags>();
+  app->add_option("--sequence", flags->sequence, "sequence folder")->required();
+  app->add_option("--config", flags->config,
+                  "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
+                  "else required; presets in config/)");
+  app->add_option("--out", flags->out, "output folder")->capture_default_str();
+  app->add_option("--max-frames", flags->max_frames, "process at most this many frames (0 = all)")
+      ->check(in_range(size_t{0}, size_t{1000000000}))
+      ->capture_default_str();
+  app->add_flag("--no-local-mapping", flags->no_local_mapping,
+                "track only: keyframes enter the map but are never refined (debugging)");
+  app->add_option("--dynamic", flags->dynamic,
+                  "dynamic-scene mode: off | semantic | geometry | full | exhaustive | auto "
+                  "(auto = full when the segmentation model loads, else geometry)")
+      ->check(CLI::IsMember({"off", "semantic", "geometry", "full", "exhaustive", "auto"}))
+      ->capture_default_str();
+  app->add_option("--model", flags->model,
+                  "segmentation metadata YAML (default: the shipped models/pspnet/pspnet.yaml)");
+  app->add_flag("--realtime", flags->realtime,
+                "feed frames at the sequence's rate (late frames are dropped) and never wait for "
+                "segmentation or local mapping: use the newest mask, warped into the frame "
+                "(default: deterministic, each frame waits for its mask and for local mapping "
+                "to finish the previous keyframe)");
+  app->add_option("--mask-margin", flags->mask_margin,
+                  "dilation of the semantic dynamic mask (pixels)")
+      ->check(in_range(0, 100))
+      ->capture_default_str();
+  app->add_option("--keyframe-ratio", flags->keyframe_ratio,
+                  "a frame becomes a keyframe when it tracks fewer than this share of its "
+                  "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)")
+      ->check(in_range(0.01, 1.0))
+      ->capture_default_str();
+  app->add_option("--vocabulary", flags->vocabulary,
+                  "ORB bag-of-words vocabulary for relocalisation and loop closing (default: the "
+                  "shipped models/vocabulary/orb_k10_l5.pspvoc)");
+  app->add_flag("--no-relocalization", flags->no_relocalization,
+                "do not relocalise when tracking is lost (and do not load the vocabulary)");
+  app->add_option("--loop-closing", flags->loop_closing,
+                  "loop closing thread (detection, essential-graph correction, global BA); auto = "
+                  "on when the vocabulary file exists")
+      ->check(CLI::IsMember({"on", "off", "auto"}))
+      ->capture_default_str();
+  app->add_option("--save-map", flags->save_map,
+                  "write the final map to this file (binary, see docs/place_recognition.md)");
+  CLI::Option* load_map =
+      app->add_option("--load-map", flags->load_map,
+                      "start from this saved map: the first frame is relocalised in it")
+          ->check(CLI::ExistingFile);
+  app->add_flag("--localization", flags->localization,
+                "localisation only (needs --load-map): track in the map, never add to it")
+      ->needs(load_map);
+  app->add_option("--blackout", flags->blackout,
+                  "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
+                  "(tracking is lost for real; tests relocalisation)")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            try {
+              parse_blackout(value);
+              return std::string();
+            } catch (const Error& e) {
+              return std::string(e.what());
+            }
+          },
+          "FROM:COUNT"));
+  app->add_option("--cull-hits", flags->cull_hits,
+                  "erase a map point after it lay on dynamic pixels in this many frames")
+      ->check(in_range(1, 1000))
+      ->capture_default_str();
+  app->add_option("--export-map", flags->export_map,
+                  "write the final static map points as a PLY point cloud (dynamic points never "
+                  "enter the map or are culled from it)");
+  app->add_option("--export-dense", flags->export_dense,
+                  "also write a dense PLY cloud back-projected from the keyframes' depth at their "
+                  "final poses, dynamic pixels left out (1 cm voxels, every 4th pixel)");
+  return {app, [flags](const GlobalOptions& global) { return run_slam(*flags, global); }};
 }
 
 }  // namespace pspslam::cli

@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "commands.h"
-#include "pspslam/core/arg_parser.h"
+#include "flag_checks.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/output_paths.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/semantic/onnx_segmenter.h"
 
@@ -42,40 +44,24 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-}  // namespace
+struct SegmentFlags {
+  std::string model = (source_dir() / "models" / "pspnet" / "pspnet.yaml").string();
+  std::string images;
+  std::string out;
+  int limit = 0;
+  int start = 0;
+  int step = 1;
+  int threads = 2;
+  int dilation = 0;
+};
 
-int segment_command(const std::vector<std::string>& args) {
-  ArgParser parser("pspslam segment",
-                   "Segment images with an ONNX network described by a metadata YAML; writes "
-                   "<name>_overlay.png (class colours), <name>_labels.png (class ids) and "
-                   "<name>_mask.png (255 = dynamic class) and prints the inference time.");
-  parser.add_option("model", "segmenter metadata YAML",
-                    (source_dir() / "models" / "pspnet" / "pspnet.yaml").string());
-  parser.add_option("images", "folder of .png/.jpg images (sorted by name)", "", true);
-  parser.add_option("out", "output folder (created when missing)", "", true);
-  parser.add_option("limit", "segment at most N images (0 = all)", "0");
-  parser.add_option("start", "skip the first N images", "0");
-  parser.add_option("step", "take every N-th image", "1");
-  parser.add_option("threads", "OpenCV CPU threads", "2");
-  parser.add_option("dilation", "dynamic mask margin in pixels", "0");
-  if (!parser.parse(args)) return 0;
-
-  const int limit = parser.get_int("limit");
-  const int start = parser.get_int("start");
-  const int step = parser.get_int("step");
-  const int threads = parser.get_int("threads");
-  const int dilation = parser.get_int("dilation");
-  if (limit < 0) throw Error("segment: flag --limit must be >= 0, got " + parser.get("limit"));
-  if (start < 0) throw Error("segment: flag --start must be >= 0, got " + parser.get("start"));
-  if (step < 1) throw Error("segment: flag --step must be >= 1, got " + parser.get("step"));
-  if (threads < 1)
-    throw Error("segment: flag --threads must be >= 1, got " + parser.get("threads"));
-  if (dilation < 0) {
-    throw Error("segment: flag --dilation must be >= 0, got " + parser.get("dilation"));
-  }
+int segment(const SegmentFlags& flags) {
+  const int limit = flags.limit, start = flags.start, step = flags.step, threads = flags.threads,
+            dilation = flags.dilation;
+  prepare_output_folder(flags.out, "--out");
   cv::setNumThreads(threads);
 
-  const auto files = list_images(parser.get("images"));
+  const auto files = list_images(flags.images);
   std::vector<std::filesystem::path> chosen;
   for (size_t i = static_cast<size_t>(start); i < files.size(); i += static_cast<size_t>(step)) {
     if (limit > 0 && chosen.size() >= static_cast<size_t>(limit)) break;
@@ -83,10 +69,9 @@ int segment_command(const std::vector<std::string>& args) {
   }
   if (chosen.empty()) throw Error("segment: --start/--step/--limit select no image");
 
-  auto segmenter = OnnxSegmenter::from_file(parser.get("model"));
+  auto segmenter = OnnxSegmenter::from_file(flags.model);
   const auto dynamic_ids = segmenter->default_dynamic_classes();
-  const std::filesystem::path out = parser.get("out");
-  std::filesystem::create_directories(out);
+  const std::filesystem::path out = flags.out;
 
   std::vector<double> times;
   for (size_t i = 0; i < chosen.size(); ++i) {
@@ -116,6 +101,37 @@ int segment_command(const std::vector<std::string>& args) {
             << " threads: median " << median(steady) << " ms over " << steady.size()
             << " images (first " << times.front() << " ms), outputs in " << out.string() << "\n";
   return 0;
+}
+
+}  // namespace
+
+Command add_segment_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "segment",
+      "segment images with an ONNX network (overlays, masks, timing).\n"
+      "Writes <name>_overlay.png (class colours), <name>_labels.png (class ids) and "
+      "<name>_mask.png (255 = dynamic class) and prints the inference time.");
+  auto flags = std::make_shared<SegmentFlags>();
+  app->add_option("--model", flags->model, "segmenter metadata YAML")->capture_default_str();
+  app->add_option("--images", flags->images, "folder of .png/.jpg images (sorted by name)")
+      ->required();
+  app->add_option("--out", flags->out, "output folder (created when missing)")->required();
+  app->add_option("--limit", flags->limit, "segment at most N images (0 = all)")
+      ->check(in_range(0, 1000000000))
+      ->capture_default_str();
+  app->add_option("--start", flags->start, "skip the first N images")
+      ->check(in_range(0, 1000000000))
+      ->capture_default_str();
+  app->add_option("--step", flags->step, "take every N-th image")
+      ->check(in_range(1, 1000000))
+      ->capture_default_str();
+  app->add_option("--threads", flags->threads, "OpenCV CPU threads")
+      ->check(in_range(1, 256))
+      ->capture_default_str();
+  app->add_option("--dilation", flags->dilation, "dynamic mask margin in pixels")
+      ->check(in_range(0, 200))
+      ->capture_default_str();
+  return {app, [flags](const GlobalOptions&) { return segment(*flags); }};
 }
 
 }  // namespace pspslam::cli

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -12,8 +13,9 @@
 #include <vector>
 
 #include "commands.h"
-#include "pspslam/core/arg_parser.h"
+#include "flag_checks.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/output_paths.h"
 #include "pspslam/core/progress.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/place/vocabulary.h"
@@ -92,48 +94,29 @@ std::vector<cv::Mat> photo_views(const cv::Mat& gray) {
   return views;
 }
 
-int train(const std::vector<std::string>& args) {
-  ArgParser parser("pspslam vocab train",
-                   "Train a bag-of-words vocabulary (hierarchical k-means over ORB descriptors, "
-                   "TF-IDF weights) from photographs and/or synthetic frames.");
-  parser.add_multi_option("images", "directory of training images (read recursively: jpg, png)");
-  parser.add_option("synthetic-frames", "synthetic frames to add (20 per seed)", "0");
-  parser.add_option("synthetic-seed", "first synth seed (tests use seeds < 1000)", "1000");
-  parser.add_option("out", "vocabulary file to write", "", true);
-  parser.add_option("k", "branching factor", "10");
-  parser.add_option("levels", "tree depth L", "5");
-  parser.add_option("max-descriptors", "random subsample of descriptors for k-means", "1500000");
-  parser.add_option("iterations", "k-means iterations per node (at most)", "10");
-  parser.add_option("seed", "random seed (subsampling, k-means++)", "1");
-  if (!parser.parse(args)) return 0;
-
+struct TrainFlags {
+  std::vector<std::string> images;
+  int synthetic_frames = 0;
+  int synthetic_seed = 1000;
+  std::string out;
   VocabularyParams params;
-  params.branching = parser.get_int("k");
-  params.levels = parser.get_int("levels");
-  params.max_iterations = parser.get_int("iterations");
-  const int seed = parser.get_int("seed");
-  if (seed < 0) throw Error("vocab train: --seed must be >= 0, got " + parser.get("seed"));
-  params.seed = static_cast<std::uint64_t>(seed);
+  int max_descriptors = 1500000;
+  bool progress = true;
+};
+
+int train(const TrainFlags& flags) {
+  const VocabularyParams& params = flags.params;
   params.validate();
-  const int synthetic_frames = parser.get_int("synthetic-frames");
-  if (synthetic_frames < 0) {
-    throw Error("vocab train: --synthetic-frames must be >= 0, got " +
-                parser.get("synthetic-frames"));
-  }
-  const int synthetic_seed = parser.get_int("synthetic-seed");
-  if (synthetic_seed < 1000) {
-    throw Error(
-        "vocab train: --synthetic-seed must be >= 1000 (seeds below are reserved for "
-        "tests and benchmarks), got " +
-        parser.get("synthetic-seed"));
-  }
-  const int max_descriptors = parser.get_int("max-descriptors");
+  const int synthetic_frames = flags.synthetic_frames;
+  const int synthetic_seed = flags.synthetic_seed;
+  const int max_descriptors = flags.max_descriptors;
   if (max_descriptors < params.branching) {
     throw Error("vocab train: --max-descriptors must be >= --k, got " +
-                parser.get("max-descriptors"));
+                std::to_string(max_descriptors));
   }
-  const fs::path out = parser.get("out");
-  const std::vector<fs::path> photos = find_images(parser.get_all("images"));
+  const fs::path out = flags.out;
+  prepare_output_file(out, "--out");
+  const std::vector<fs::path> photos = find_images(flags.images);
   if (photos.empty() && synthetic_frames == 0) {
     throw Error(
         "vocab train: no training data: give --images DIR (with jpg/png files) and/or "
@@ -157,7 +140,7 @@ int train(const std::vector<std::string>& args) {
   std::cout << "training images: " << photos.size() << " photographs, " << synthetic_frames
             << " synthetic frames\n";
   ProgressBar extract_progress("orb", photos.size() + static_cast<size_t>(synthetic_frames),
-                               std::cerr);
+                               std::cerr, flags.progress);
   size_t done = 0;
   size_t photo_views_used = 0;
   size_t synthetic_used = 0;
@@ -219,8 +202,8 @@ int train(const std::vector<std::string>& args) {
   }
 
   const auto kmeans_start = Clock::now();
-  ProgressBar tree_progress("k-means", sample, std::cerr);
-  ProgressBar idf_progress("idf", image_descriptors.size(), std::cerr);
+  ProgressBar tree_progress("k-means", sample, std::cerr, flags.progress);
+  ProgressBar idf_progress("idf", image_descriptors.size(), std::cerr, flags.progress);
   const Vocabulary vocabulary =
       Vocabulary::train(tree_descriptors, image_descriptors, params,
                         [&](const std::string& stage, std::size_t n, std::size_t total) {
@@ -249,17 +232,16 @@ int train(const std::vector<std::string>& args) {
   return 0;
 }
 
-int info(const std::vector<std::string>& args) {
-  ArgParser parser("pspslam vocab info",
-                   "Load a vocabulary, print its shape, load time and the speed of descriptor -> "
-                   "word lookup on synthetic frames.");
-  parser.add_option("vocabulary", "vocabulary file", "", true);
-  parser.add_option("frames", "synthetic frames to time lookups on", "20");
-  parser.add_option("repeat", "lookup passes over the descriptors", "5");
-  if (!parser.parse(args)) return 0;
-  const fs::path file = parser.get("vocabulary");
-  const int frames = std::max(1, parser.get_int("frames"));
-  const int repeat = std::max(1, parser.get_int("repeat"));
+struct InfoFlags {
+  std::string vocabulary;
+  int frames = 20;
+  int repeat = 5;
+};
+
+int info(const InfoFlags& flags) {
+  const fs::path file = flags.vocabulary;
+  const int frames = flags.frames;
+  const int repeat = flags.repeat;
 
   const auto load_start = Clock::now();
   const Vocabulary vocabulary = Vocabulary::load(file);
@@ -324,18 +306,59 @@ int info(const std::vector<std::string>& args) {
 
 }  // namespace
 
-int vocab_command(const std::vector<std::string>& args) {
-  const std::string usage =
-      "usage: pspslam vocab train|info [flags]   (pspslam vocab <sub-command> --help)";
-  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::cout << usage << "\n  train  train a bag-of-words vocabulary\n"
-              << "  info   load a vocabulary, print its shape, load time and lookup speed\n";
-    return args.empty() ? 2 : 0;
-  }
-  const std::vector<std::string> rest(args.begin() + 1, args.end());
-  if (args[0] == "train") return train(rest);
-  if (args[0] == "info") return info(rest);
-  throw Error("vocab: unknown sub-command '" + args[0] + "' (" + usage + ")");
+Command add_vocab_train_command(CLI::App& vocab) {
+  CLI::App* app = vocab.add_subcommand(
+      "train",
+      "train a bag-of-words vocabulary (hierarchical k-means over ORB descriptors, TF-IDF "
+      "weights) from photographs and/or synthetic frames");
+  auto flags = std::make_shared<TrainFlags>();
+  app->add_option("--images", flags->images,
+                  "directory of training images (read recursively: jpg, png; repeatable)");
+  app->add_option("--synthetic-frames", flags->synthetic_frames,
+                  "synthetic frames to add (20 per seed)")
+      ->check(in_range(0, 1000000))
+      ->capture_default_str();
+  app->add_option("--synthetic-seed", flags->synthetic_seed,
+                  "first synth seed (>= 1000: seeds below are reserved for tests and benchmarks)")
+      ->check(in_range(1000, 1000000000))
+      ->capture_default_str();
+  app->add_option("--out", flags->out, "vocabulary file to write")->required();
+  app->add_option("--k", flags->params.branching, "branching factor")
+      ->check(in_range(2, 64))
+      ->capture_default_str();
+  app->add_option("--levels", flags->params.levels, "tree depth L")
+      ->check(in_range(1, 8))
+      ->capture_default_str();
+  app->add_option("--max-descriptors", flags->max_descriptors,
+                  "random subsample of descriptors for k-means")
+      ->check(in_range(2, 100000000))
+      ->capture_default_str();
+  app->add_option("--iterations", flags->params.max_iterations,
+                  "k-means iterations per node (at most)")
+      ->check(in_range(1, 1000))
+      ->capture_default_str();
+  app->add_option("--seed", flags->params.seed, "random seed (subsampling, k-means++)")
+      ->check(in_range(uint64_t{0}, uint64_t{4294967295}))
+      ->capture_default_str();
+  return {app, [flags](const GlobalOptions& global) {
+            TrainFlags run = *flags;
+            run.progress = !global.quiet;
+            return train(run);
+          }};
+}
+
+Command add_vocab_info_command(CLI::App& vocab) {
+  CLI::App* app = vocab.add_subcommand(
+      "info", "load a vocabulary, print its shape, load time and lookup speed");
+  auto flags = std::make_shared<InfoFlags>();
+  app->add_option("--vocabulary", flags->vocabulary, "vocabulary file")->required();
+  app->add_option("--frames", flags->frames, "synthetic frames to time lookups on")
+      ->check(in_range(1, 300))
+      ->capture_default_str();
+  app->add_option("--repeat", flags->repeat, "lookup passes over the descriptors")
+      ->check(in_range(1, 1000))
+      ->capture_default_str();
+  return {app, [flags](const GlobalOptions&) { return info(*flags); }};
 }
 
 }  // namespace pspslam::cli

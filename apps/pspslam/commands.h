@@ -1,16 +1,29 @@
 #pragma once
 
-#include <string>
-#include <vector>
+#include <CLI/CLI.hpp>
+
+#include <functional>
 
 namespace pspslam::cli {
 
-// Each sub-command receives the arguments after its name and returns the process exit code.
-// Errors are thrown as pspslam::Error and reported by main().
-int run_command(const std::vector<std::string>& args);
-int eval_command(const std::vector<std::string>& args);
-int synth_command(const std::vector<std::string>& args);
-int segment_command(const std::vector<std::string>& args);
-int vocab_command(const std::vector<std::string>& args);
+// A sub-command registered on the root CLI11 app. Its flags are bound to an options struct that
+// the `run` closure owns, so everything is parsed and range-checked by CLI11 before any work
+// starts; `run` then does the work and returns the process exit status. Errors are thrown as
+// pspslam::Error and reported by main().
+struct GlobalOptions {
+  bool quiet = false;  // --quiet: no progress bar, only warnings and errors
+};
+
+struct Command {
+  CLI::App* app = nullptr;  // owned by the root app
+  std::function<int(const GlobalOptions&)> run;
+};
+
+Command add_run_command(CLI::App& root);
+Command add_eval_command(CLI::App& root);
+Command add_synth_command(CLI::App& root);
+Command add_segment_command(CLI::App& root);
+Command add_vocab_train_command(CLI::App& vocab);
+Command add_vocab_info_command(CLI::App& vocab);
 
 }  // namespace pspslam::cli

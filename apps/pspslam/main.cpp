@@ -1,62 +1,150 @@
-#include <functional>
+// `pspslam`: the command line. CLI11 parses and range-checks every flag of the chosen
+// sub-command before any work starts; spdlog carries the diagnostics (warnings, errors, debug)
+// to stderr while results go to stdout.
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/suggest.h"
+#include "pspslam/core/version.h"
 
 namespace {
 
-struct Command {
-  const char* name;
-  const char* summary;
-  std::function<int(const std::vector<std::string>&)> run;
-};
-
-const std::vector<Command>& commands() {
-  static const std::vector<Command> table = {
-      {"run", "run SLAM on an RGB-D sequence and write the trajectory", pspslam::cli::run_command},
-      {"eval", "ATE / RPE of an estimated trajectory against ground truth",
-       pspslam::cli::eval_command},
-      {"synth", "render a synthetic dynamic RGB-D sequence", pspslam::cli::synth_command},
-      {"segment", "segment images with an ONNX network (overlays, masks, timing)",
-       pspslam::cli::segment_command},
-      {"vocab", "train / inspect the bag-of-words vocabulary", pspslam::cli::vocab_command},
-  };
-  return table;
+// "pspslam vocab train" for the deepest sub-command the arguments reached.
+const CLI::App* chosen_command(const CLI::App& root) {
+  const CLI::App* app = &root;
+  for (bool deeper = true; deeper;) {
+    deeper = false;
+    for (const CLI::App* sub : app->get_subcommands()) {
+      app = sub;
+      deeper = true;
+      break;
+    }
+  }
+  return app;
 }
 
-void print_usage(std::ostream& out) {
-  out << "usage: pspslam <command> [flags]   (pspslam <command> --help for its flags)\n\n"
-         "commands:\n";
-  for (const Command& c : commands()) {
-    out << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
+std::string command_path(const CLI::App* app) {
+  std::string path = app->get_name();
+  for (const CLI::App* parent = app->get_parent(); parent; parent = parent->get_parent())
+    path = parent->get_name() + " " + path;
+  return path;
+}
+
+// CLI11 names what it did not expect; we also suggest the flag the user probably meant, and
+// list the commands when none was given.
+std::string explain(const CLI::ParseError& error, const CLI::App* app,
+                    const std::vector<std::string>& words) {
+  std::string message = error.what();
+  if (dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr) {
+    std::vector<std::string> names;
+    for (const CLI::App* scope = app; scope != nullptr; scope = scope->get_parent()) {
+      for (const CLI::Option* option : scope->get_options()) {
+        for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+      }
+    }
+    for (const std::string& word : words) {
+      const std::string flag = word.substr(0, word.find('='));
+      if (flag.rfind("--", 0) != 0) continue;
+      if (std::find(names.begin(), names.end(), flag) != names.end()) continue;
+      if (const auto best = pspslam::nearest(flag, names)) {
+        message += " (did you mean " + *best + "?)";
+        break;
+      }
+    }
   }
+  return message;
+}
+
+// "  run       run SLAM on ..." lines, when the error is that no command was given.
+std::string command_list(const CLI::ParseError& error, const CLI::App* app) {
+  if (dynamic_cast<const CLI::RequiredError*>(&error) == nullptr ||
+      app->get_subcommands({}).empty() || !app->get_subcommands().empty()) {
+    return "";
+  }
+  std::string list = "commands:\n";
+  for (const CLI::App* sub : app->get_subcommands({})) {
+    const std::string& name = sub->get_name();
+    list += "  " + name + std::string(name.size() < 10 ? 10 - name.size() : 1, ' ') +
+            sub->get_description().substr(0, sub->get_description().find('\n')) + "\n";
+  }
+  return list;
+}
+
+void configure_logging(const std::string& level, bool quiet) {
+  auto logger = spdlog::stderr_logger_st("pspslam");
+  // "warning: ...", "error: ...": the form the messages had before spdlog, which tests and users
+  // grep for.
+  logger->set_pattern("%l: %v");
+  logger->set_level(quiet ? spdlog::level::warn : spdlog::level::from_str(level));
+  logger->flush_on(spdlog::level::trace);
+  spdlog::set_default_logger(logger);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    print_usage(argc < 2 ? std::cerr : std::cout);
-    return argc < 2 ? 2 : 0;
+  CLI::App root{
+      "pspslam: dynamic-scene SLAM (ORB-SLAM2 core, PSPNet semantic masks, "
+      "multi-view geometry)",
+      "pspslam"};
+  root.require_subcommand(1);
+  root.set_version_flag("--version", pspslam::version_string());
+  std::string log_level = "info";
+  bool quiet = false;
+  root.add_option("--log-level", log_level,
+                  "diagnostics on stderr: trace|debug|info|warn|error|off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->capture_default_str();
+  root.add_flag("--quiet,-q", quiet, "only warnings and errors on stderr, no progress bar");
+
+  std::vector<pspslam::cli::Command> commands = {
+      pspslam::cli::add_run_command(root), pspslam::cli::add_eval_command(root),
+      pspslam::cli::add_synth_command(root), pspslam::cli::add_segment_command(root)};
+  CLI::App* vocab = root.add_subcommand("vocab", "train / inspect the bag-of-words vocabulary");
+  vocab->require_subcommand(1);
+  commands.push_back(pspslam::cli::add_vocab_train_command(*vocab));
+  commands.push_back(pspslam::cli::add_vocab_info_command(*vocab));
+  // Global flags may also follow the sub-command name.
+  for (CLI::App* sub : root.get_subcommands({})) sub->fallthrough();
+  vocab->fallthrough();
+
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::CallForHelp& help) {
+    return root.exit(help);
+  } catch (const CLI::CallForAllHelp& help) {
+    return root.exit(help);
+  } catch (const CLI::CallForVersion& version) {
+    return root.exit(version);
+  } catch (const CLI::ParseError& error) {
+    const CLI::App* app = chosen_command(root);
+    const std::vector<std::string> words(argv + 1, argv + argc);
+    std::cerr << "error: " << command_path(app) << ": " << explain(error, app, words) << " (see '"
+              << command_path(app) << " --help')\n"
+              << command_list(error, app);
+    return 2;
   }
-  const std::string name = argv[1];
-  const std::vector<std::string> args(argv + 2, argv + argc);
-  for (const Command& c : commands()) {
-    if (name != c.name) continue;
+  configure_logging(log_level, quiet);
+  for (const pspslam::cli::Command& command : commands) {
+    if (!command.app->parsed()) continue;
     try {
-      return c.run(args);
+      return command.run(pspslam::cli::GlobalOptions{quiet});
     } catch (const pspslam::Error& e) {
-      std::cerr << "error: " << e.what() << "\n";
+      spdlog::error("{}", e.what());
       return 2;
     } catch (const std::exception& e) {
-      std::cerr << "internal error: " << e.what() << "\n";
+      spdlog::error("internal error: {}", e.what());
       return 3;
     }
   }
-  std::cerr << "error: unknown command '" << name << "'\n\n";
-  print_usage(std::cerr);
+  std::cerr << root.help();
   return 2;
 }

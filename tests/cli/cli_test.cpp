@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -20,6 +22,15 @@ Result pspslam(const std::string& arguments) {
   Result result;
   result.status =
       testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " " + arguments, &result.output);
+  return result;
+}
+
+// The same, run from `folder` (relative paths are the user's, not the source tree's).
+Result pspslam_in(const std::filesystem::path& folder, const std::string& arguments) {
+  Result result;
+  result.status = testing::run_shell(
+      "cd '" + folder.string() + "' && " + std::string(PSPSLAM_CLI_PATH) + " " + arguments,
+      &result.output);
   return result;
 }
 
@@ -80,14 +91,15 @@ std::filesystem::path make_sequence(const std::string& tag, bool with_config) {
 TEST(CliEval, MissingRequiredFlag) {
   const Result r = pspslam("eval --est x.txt");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output,
-            "error: pspslam eval: missing required flag --gt (see 'pspslam eval --help')\n");
+  EXPECT_EQ(r.output, "error: pspslam eval: --gt is required (see 'pspslam eval --help')\n");
 }
 
 TEST(CliEval, UnknownFlag) {
   const Result r = pspslam("eval --gt a --est b --plots out");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output, "error: pspslam eval: unknown flag --plots (see 'pspslam eval --help')\n");
+  EXPECT_EQ(r.output,
+            "error: pspslam eval: The following arguments were not expected: out --plots (did you "
+            "mean --plot?) (see 'pspslam eval --help')\n");
 }
 
 TEST(CliEval, HelpListsFlags) {
@@ -106,9 +118,12 @@ TEST(CliEval, BadValuesAndFiles) {
       " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
   Result r = pspslam("eval" + files + " --rpe-unit m");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output, "error: pspslam eval: flag --rpe-unit expects 's' or 'f', got 'm'\n");
+  EXPECT_EQ(r.output,
+            "error: pspslam eval: --rpe-unit: m not in {s,f} (see 'pspslam eval --help')\n");
   r = pspslam("eval" + files + " --max-dt fast");
-  EXPECT_EQ(r.output, "error: pspslam eval: flag --max-dt expects a number, got 'fast'\n");
+  EXPECT_EQ(r.output,
+            "error: pspslam eval: --max-dt: must be a number in [1e-09, 1e+09], got 'fast' (see "
+            "'pspslam eval --help')\n");
   r = pspslam("eval --gt " + (dir / "none.txt").string() + " --est " + (dir / "est.txt").string());
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.output, "error: " + (dir / "none.txt").string() + ": cannot open trajectory file\n");
@@ -135,12 +150,17 @@ TEST(CliEval, TableJsonAndPlots) {
   r = pspslam("eval --gt " + (dir / "gt.txt").string() + " --est " + (dir / "scaled.txt").string() +
               " --json --sim3 --plot " + (dir / "plots").string());
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "\"ate\": {\"alignment\": \"sim3\", \"max_dt_s\": 0.02"))
-      << r.output;
-  EXPECT_TRUE(contains(r.output, "\"rpe\": {\"delta\": 1, \"delta_unit\": \"s\"")) << r.output;
-  // With scale the 1.1x copy fits exactly: scale 1/1.1 printed in full precision, ATE ~ 0.
+  // stdout is one JSON document (the plot list goes to stderr, which r.output also holds).
+  const nlohmann::json report = nlohmann::json::parse(r.output.substr(0, r.output.rfind("}") + 1));
+  EXPECT_EQ(report["ate"]["alignment"], "sim3");
+  EXPECT_EQ(report["ate"]["max_dt_s"], 0.02);
+  EXPECT_EQ(report["rpe"]["delta"], 1.0);
+  EXPECT_EQ(report["rpe"]["delta_unit"], "s");
+  // With scale the 1.1x copy fits exactly: scale 1/1.1 written so that it reads back exactly.
+  EXPECT_NEAR(report["ate"]["scale"].get<double>(), 1.0 / 1.1, 1e-12);
   EXPECT_TRUE(contains(r.output, "\"scale\": 0.90909090909")) << r.output;
-  EXPECT_TRUE(contains(r.output, "\"error_m\": {\"count\": 151, \"rmse\": ")) << r.output;
+  EXPECT_EQ(report["ate"]["error_m"]["count"], 151);
+  EXPECT_LT(report["ate"]["error_m"]["rmse"].get<double>(), 1e-9);
   for (const char* name : {"trajectory_top_view.png", "trajectory_top_view.svg",
                            "ate_over_time.png", "ate_over_time.svg"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "plots" / name)) << name;
@@ -150,8 +170,7 @@ TEST(CliEval, TableJsonAndPlots) {
 TEST(CliRun, MissingSequenceFlagAndConfig) {
   Result r = pspslam("run");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output,
-            "error: pspslam run: missing required flag --sequence (see 'pspslam run --help')\n");
+  EXPECT_EQ(r.output, "error: pspslam run: --sequence is required (see 'pspslam run --help')\n");
   const auto dir = make_sequence("cli", false);
   r = pspslam("run --sequence " + dir.string());
   EXPECT_EQ(r.status, 2);
@@ -229,7 +248,10 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
     const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
                              (dir / "bad").string() + " --keyframe-ratio " + bad);
     EXPECT_EQ(r.status, 2);
-    EXPECT_TRUE(contains(r.output, "error: --keyframe-ratio must be in (0, 1], got " + bad))
+    EXPECT_TRUE(contains(r.output,
+                         "error: pspslam run: --keyframe-ratio: must be a number in "
+                         "[0.01, 1], got '" +
+                             bad + "'"))
         << r.output;
   }
 }
@@ -289,6 +311,127 @@ TEST(CliRun, ExportsStaticMapAndDenseCloudAsPly) {
       ++outside;
   }
   EXPECT_LT(outside, dense.size() / 200) << outside << " of " << dense.size();
+}
+
+}  // namespace
+}  // namespace pspslam
+
+namespace pspslam {
+namespace {
+
+// Output paths are checked before anything is read: an --out below a regular file is a clear
+// error with status 2 even though the sequence does not exist either.
+TEST(CliRun, OutputUnderAFileIsRefusedBeforeAnyWork) {
+  const auto dir = testing::make_temp_dir("cli_out_file");
+  std::ofstream(dir / "plain") << "not a folder";
+  Result r = pspslam("run --sequence " + (dir / "absent").string() + " --out " +
+                     (dir / "plain" / "run").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: --out '" + (dir / "plain" / "run").string() + "': '" +
+                          (dir / "plain").string() + "' is a file, not a folder\n");
+  r = pspslam("run --sequence " + (dir / "absent").string() + " --out " + (dir / "ok").string() +
+              " --save-map " + (dir / "plain" / "room.map").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: --save-map '" + (dir / "plain").string() + "': '" +
+                          (dir / "plain").string() + "' is a file, not a folder\n");
+}
+
+// Flag values are checked by the parser, before the sequence is read (it does not exist here).
+TEST(CliRun, FlagValuesAreCheckedBeforeAnyWork) {
+  const std::string run = "run --sequence /nonexistent/sequence ";
+  Result r = pspslam(run + "--dynamic foo");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(
+      r.output,
+      "error: pspslam run: --dynamic: foo not in {off,semantic,geometry,full,exhaustive,auto} "
+      "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--mask-margin 1000000000");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --mask-margin: must be an integer in [0, 100], got '1000000000' "
+            "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--localization");
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --localization requires --load-map (see 'pspslam run --help')\n");
+  r = pspslam(run + "--blackout 3");
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --blackout: --blackout expects FROM:COUNT (frame index and a "
+            "positive number of frames), got '3' (see 'pspslam run --help')\n");
+  r = pspslam(run + "--max-frames -1");
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --max-frames: must be an integer in [0, 1000000000], got '-1' "
+            "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--realtme");
+  EXPECT_EQ(r.output,
+            "error: pspslam run: The following argument was not expected: --realtme (did you mean "
+            "--realtime?) (see 'pspslam run --help')\n");
+}
+
+// A path the user types is relative to the current folder, not to the source tree.
+TEST(CliRun, UserPathsAreRelativeToTheCurrentFolder) {
+  const auto dir = make_sequence("cli_relative", true);
+  std::ofstream(dir / "badvoc") << "not a vocabulary";
+  Result r = pspslam_in(dir,
+                        "run --sequence . --out out --dynamic off --loop-closing on "
+                        "--vocabulary badvoc");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: vocabulary file 'badvoc': ")) << r.output;
+  r = pspslam_in(dir, "run --sequence . --out out --dynamic full --model m.yaml");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output,
+                       "error: --dynamic full: segmentation model not usable: cannot open "
+                       "segmenter metadata 'm.yaml'"))
+      << r.output;
+}
+
+// stats.json is JSON whatever the sequence path holds: quotes, backslashes, non-ASCII.
+TEST(CliRun, StatsJsonEscapesTheSequencePath) {
+  const auto base = make_sequence("cli_quotes", true);
+  const auto dir = base.parent_path() / "bonn \"quoted\" back\\slash caf\xc3\xa9";
+  std::filesystem::remove_all(dir);
+  std::filesystem::rename(base, dir);
+  const Result r = pspslam("run --sequence '" + dir.string() + "' --out '" +
+                           (dir / "out").string() + "' --dynamic off");
+  ASSERT_TRUE(std::filesystem::exists(dir / "out" / "stats.json")) << r.output;
+  std::ifstream in(dir / "out" / "stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  EXPECT_EQ(stats["sequence"].get<std::string>(), dir.string());
+  EXPECT_EQ(stats["mode"], "off");
+  EXPECT_EQ(stats["frames"], 3);
+}
+
+// A mistyped config key is named, with the key it probably meant.
+TEST(CliRun, MistypedConfigKeyIsNamedWithASuggestion) {
+  const auto dir = make_sequence("cli_typo", false);
+  std::ofstream(dir / "typo.yaml")
+      << "camera:\n  widht: 8\n  height: 6\n  fx: 10\n  fy: 10\n  cx: 4\n  cy: 3\n";
+  const Result r = pspslam("run --sequence " + dir.string() + " --out " + (dir / "out").string() +
+                           " --config " + (dir / "typo.yaml").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: " + (dir / "typo.yaml").string() +
+                          ":2: unknown key 'camera.widht' (did you mean 'camera.width'?)\n");
+}
+
+TEST(Cli, VersionQuietAndLogLevel) {
+  Result r = pspslam("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.output.rfind("pspslam 0.1.0 (git ", 0), 0u) << r.output;
+  const auto dir = make_sequence("cli_quiet", true);
+  r = pspslam("--quiet run --sequence " + dir.string() + " --out " + (dir / "q").string() +
+              " --dynamic off");
+  EXPECT_FALSE(contains(r.output, "slam [")) << r.output;  // no progress bar
+  EXPECT_FALSE(contains(r.output, "debug: ")) << r.output;
+  r = pspslam("run --log-level debug --sequence " + dir.string() + " --out " +
+              (dir / "d").string() + " --dynamic off");
+  EXPECT_TRUE(contains(r.output, "debug: frame 0 ")) << r.output;
+  r = pspslam("--log-level chatty run --sequence x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --log-level: chatty not in {trace,debug,info,warn,error,off} (see "
+            "'pspslam run --help')\n");
+  r = pspslam("");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "commands:\n  run ")) << r.output;
 }
 
 }  // namespace

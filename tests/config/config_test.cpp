@@ -132,8 +132,11 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
   const auto dir = testing::make_temp_dir("config");
   const auto file = write_file(dir, replace(kValidCamera, "  fx: 500.5\n", "  fxx: 500.5\n"));
-  // fxx is reported as unknown only after the required fx is found missing.
-  EXPECT_EQ(load_error(file), file.string() + ": missing key 'camera.fx'");
+  // The required fx is absent because it was mistyped: the typo is named, with the key meant.
+  EXPECT_EQ(load_error(file),
+            file.string() + ":5: unknown key 'camera.fxx' (did you mean 'camera.fx'?)");
+  const auto missing = write_file(dir, replace(kValidCamera, "  fx: 500.5\n", ""));
+  EXPECT_EQ(load_error(missing), missing.string() + ": missing key 'camera.fx'");
   const auto extra = write_file(dir, std::string(kValidCamera) + "  colour: blue\n");
   EXPECT_EQ(load_error(extra), extra.string() + ":13: unknown key 'camera.colour'");
   const auto top = write_file(dir, std::string(kValidCamera) + "tracking:\n  x: 1\n");

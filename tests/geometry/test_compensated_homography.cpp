@@ -167,7 +167,10 @@ TEST(CompensatedHomography, ParamsFromYamlNameTheKey) {
     HomographyParams::from_yaml(typo_section);
     FAIL() << "expected Error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "geometry.yaml:1: unknown key 'geometry.homography.inlier_treshold_px'");
+    EXPECT_STREQ(
+        e.what(),
+        "geometry.yaml:1: unknown key 'geometry.homography.inlier_treshold_px' (did you mean "
+        "'geometry.homography.inlier_threshold_px'?)");
   }
 }
 

@@ -140,7 +140,9 @@ TEST(GeometryStage, ParamsFromYamlReadsSubsections) {
     GeometryParams::from_yaml(bad_section);
     FAIL() << "expected Error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "s.yaml:1: unknown key 'geometry.region.strid'");
+    EXPECT_STREQ(
+        e.what(),
+        "s.yaml:1: unknown key 'geometry.region.strid' (did you mean 'geometry.region.stride'?)");
   }
 }
 

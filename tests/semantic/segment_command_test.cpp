@@ -49,7 +49,9 @@ TEST(SegmentCommand, ReportsBadFlagsWithTheirName) {
                                   " --out " + dir.string() + " --step 0",
                               &output);
   EXPECT_EQ(status, 2);
-  EXPECT_NE(output.find("error: segment: flag --step must be >= 1, got 0"), std::string::npos)
+  EXPECT_NE(output.find("error: pspslam segment: --step: must be an integer in [1, 1000000], got "
+                        "'0' (see 'pspslam segment --help')"),
+            std::string::npos)
       << output;
 }
 

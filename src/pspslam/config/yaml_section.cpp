@@ -1,5 +1,9 @@
 #include "pspslam/config/yaml_section.h"
 
+#include <vector>
+
+#include "pspslam/core/suggest.h"
+
 namespace pspslam {
 
 YamlSection::YamlSection(const YAML::Node& node, std::string file, std::string path)
@@ -22,13 +26,30 @@ YamlSection YamlSection::section(const std::string& key) {
 
 void YamlSection::finish() const {
   if (!node_ || !node_.IsMap()) return;
+  const std::vector<std::string> valid(used_.begin(), used_.end());
   for (const auto& entry : node_) {
     const std::string key = entry.first.as<std::string>();
-    if (!used_.count(key)) {
-      throw Error(file_ + ":" + std::to_string(entry.first.Mark().line + 1) + ": unknown key '" +
-                  qualified(key) + "'");
+    if (!used_.count(key)) throw unknown_key(entry.first, nearest(key, valid));
+  }
+}
+
+void YamlSection::throw_missing(const std::string& key) const {
+  // A required key is most often "missing" because it was mistyped: name the typo, not only
+  // the key that was expected.
+  if (node_ && node_.IsMap()) {
+    for (const auto& entry : node_) {
+      const std::string present = entry.first.as<std::string>();
+      if (!used_.count(present) && nearest(present, {key})) throw unknown_key(entry.first, key);
     }
   }
+  throw Error(file_ + ": missing key '" + qualified(key) + "'");
+}
+
+Error YamlSection::unknown_key(const YAML::Node& key,
+                               const std::optional<std::string>& meant) const {
+  return Error(file_ + ":" + std::to_string(key.Mark().line + 1) + ": unknown key '" +
+               qualified(key.as<std::string>()) + "'" +
+               (meant ? " (did you mean '" + qualified(*meant) + "'?)" : std::string()));
 }
 
 }  // namespace pspslam

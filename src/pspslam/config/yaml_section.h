@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <optional>
 #include <set>
 #include <string>
 
@@ -10,7 +11,9 @@
 namespace pspslam {
 
 // Reads one YAML mapping strictly: every key read is remembered, and finish() rejects any key
-// that was not read, so a typo ("fxx: 500") is an error naming the key instead of being ignored.
+// that was not read, so a typo ("fxx: 500") is an error naming the key instead of being ignored,
+// with the nearest valid key as a suggestion ("unknown key 'camera.fxx' (did you mean
+// 'camera.fx'?)"); a required key that is absent because it was mistyped is reported the same way.
 class YamlSection {
  public:
   YamlSection(const YAML::Node& node, std::string file, std::string path);
@@ -21,7 +24,7 @@ class YamlSection {
   T required(const std::string& key) {
     used_.insert(key);
     const YAML::Node value = node_[key];
-    if (!value) throw Error(file_ + ": missing key '" + qualified(key) + "'");
+    if (!value) throw_missing(key);
     return convert<T>(value, key);
   }
 
@@ -44,6 +47,9 @@ class YamlSection {
   }
 
  private:
+  [[noreturn]] void throw_missing(const std::string& key) const;
+  Error unknown_key(const YAML::Node& key, const std::optional<std::string>& meant) const;
+
   template <typename T>
   T convert(const YAML::Node& value, const std::string& key) const {
     try {

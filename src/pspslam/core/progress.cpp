@@ -9,16 +9,18 @@
 
 namespace pspslam {
 
-ProgressBar::ProgressBar(std::string label, size_t total, std::ostream& out)
+ProgressBar::ProgressBar(std::string label, size_t total, std::ostream& out, bool enabled)
     : label_(std::move(label)),
       total_(total),
       out_(out),
       interactive_((&out == &std::cerr && isatty(STDERR_FILENO)) ||
                    (&out == &std::cout && isatty(STDOUT_FILENO))),
       start_(std::chrono::steady_clock::now()),
-      last_draw_(start_) {}
+      last_draw_(start_),
+      enabled_(enabled) {}
 
 void ProgressBar::update(size_t done) {
+  if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   if (interactive_) {
     if (now - last_draw_ < std::chrono::milliseconds(100) && done < total_) return;
@@ -34,7 +36,7 @@ void ProgressBar::update(size_t done) {
 }
 
 void ProgressBar::finish() {
-  if (finished_) return;
+  if (finished_ || !enabled_) return;
   finished_ = true;
   if (interactive_) {
     draw(total_, false);

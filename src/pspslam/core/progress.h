@@ -12,7 +12,8 @@ namespace pspslam {
 // it prints a plain line every 10% so logs stay short.
 class ProgressBar {
  public:
-  ProgressBar(std::string label, size_t total, std::ostream& out);
+  // `enabled` false (--quiet) draws nothing.
+  ProgressBar(std::string label, size_t total, std::ostream& out, bool enabled = true);
   void update(size_t done);
   void finish();
 
@@ -26,6 +27,7 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
   size_t last_decile_ = 0;
+  bool enabled_;
   bool finished_ = false;
 };
 

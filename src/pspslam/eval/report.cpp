@@ -1,5 +1,7 @@
 #include "pspslam/eval/report.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -19,35 +21,10 @@ std::string short_number(double value) {
   return buffer;
 }
 
-std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  return buffer;
-}
-
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_stats(const ErrorStats& s) {
-  return "{\"count\": " + std::to_string(s.count) + ", \"rmse\": " + json_number(s.rmse) +
-         ", \"mean\": " + json_number(s.mean) + ", \"median\": " + json_number(s.median) +
-         ", \"std\": " + json_number(s.std) + ", \"min\": " + json_number(s.min) +
-         ", \"max\": " + json_number(s.max) + "}";
+nlohmann::ordered_json to_json(const ErrorStats& s) {
+  // Non-finite values (an undetermined statistic) are written as null by the library.
+  return {{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
+          {"std", s.std},     {"min", s.min},   {"max", s.max}};
 }
 
 std::string table_row(const std::string& name, const std::string& unit, const ErrorStats& s,
@@ -96,25 +73,27 @@ std::string format_eval_table(const EvalSettings& settings, const AteResult& ate
 
 std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
                              const RpeResult& rpe) {
-  std::ostringstream out;
-  out << "{\n";
-  out << "  \"ground_truth\": " << json_string(settings.ground_truth_file) << ",\n";
-  out << "  \"estimate\": " << json_string(settings.estimate_file) << ",\n";
-  out << "  \"ate\": {\"alignment\": \"" << (settings.ate.sim3 ? "sim3" : "se3")
-      << "\", \"max_dt_s\": " << json_number(settings.ate.max_difference)
-      << ", \"offset_s\": " << json_number(settings.ate.offset)
-      << ", \"scale\": " << json_number(ate.alignment.scale)
-      << ", \"error_m\": " << json_stats(ate.error) << "},\n";
-  out << "  \"rpe\": {\"delta\": " << json_number(settings.rpe.delta) << ", \"delta_unit\": \""
-      << to_string(settings.rpe.unit) << "\",\n";
-  out << "          \"translation_m\": " << json_stats(rpe.translation) << ",\n";
-  out << "          \"translation_m_per_s\": " << json_stats(rpe.translation_per_second) << ",\n";
-  out << "          \"rotation_deg\": " << json_stats(rpe.rotation) << ",\n";
-  out << "          \"rotation_deg_per_s\": " << json_stats(rpe.rotation_per_second) << ",\n";
-  out << "          \"body_frame_rotation_deg\": " << json_number(rpe.body_frame_rotation_deg)
-      << ", \"body_frames_differ\": " << (rpe.body_frames_differ() ? "true" : "false") << "}\n";
-  out << "}\n";
-  return out.str();
+  // Doubles are written in the shortest form that reads back bit for bit, so the numbers
+  // compare exactly with other tools.
+  const nlohmann::ordered_json report = {
+      {"ground_truth", settings.ground_truth_file},
+      {"estimate", settings.estimate_file},
+      {"ate",
+       {{"alignment", settings.ate.sim3 ? "sim3" : "se3"},
+        {"max_dt_s", settings.ate.max_difference},
+        {"offset_s", settings.ate.offset},
+        {"scale", ate.alignment.scale},
+        {"error_m", to_json(ate.error)}}},
+      {"rpe",
+       {{"delta", settings.rpe.delta},
+        {"delta_unit", to_string(settings.rpe.unit)},
+        {"translation_m", to_json(rpe.translation)},
+        {"translation_m_per_s", to_json(rpe.translation_per_second)},
+        {"rotation_deg", to_json(rpe.rotation)},
+        {"rotation_deg_per_s", to_json(rpe.rotation_per_second)},
+        {"body_frame_rotation_deg", rpe.body_frame_rotation_deg},
+        {"body_frames_differ", rpe.body_frames_differ()}}}};
+  return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace pspslam

@@ -24,7 +24,6 @@ constexpr float kStaticTexelsPerMetre = 256.0f;
 constexpr float kBodyTexelsPerMetre = 200.0f;
 constexpr float kNearPlane_m = 0.02f;  // equals the clip plane of the screen rectangles
 constexpr int kRowsPerChunk = 8;
-constexpr int kMaxBodies = 200;  // keeps 1 + box * 6 + face inside 16-bit surface ids
 
 // What a box looks like; its pose is given separately (fixed for furniture, animated for bodies).
 struct BoxSurface {

@@ -18,6 +18,9 @@ inline constexpr uint8_t kSynthLabelStatic = 0;
 inline constexpr uint8_t kSynthLabelPerson = 15;    // PASCAL VOC id of "person"
 inline constexpr uint8_t kSynthLabelCarried = 100;  // a box (static class) carried by a person
 
+// Most walking people a scene holds: keeps 1 + box * 6 + face inside 16-bit surface ids.
+inline constexpr int kMaxBodies = 200;
+
 enum class SynthTrajectory { kHandheld, kLoop };
 
 // "handheld" | "loop"; anything else throws pspslam::Error naming the flag.

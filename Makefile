@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc)
 PSPSLAM = $(BUILD)/apps/pspslam
 DEMO ?= demo_out
 
-.PHONY: deps configure build demo test bench clean
+.PHONY: deps configure build demo test bench clean sanitize
 
 deps:
 	scripts/install-deps
@@ -24,6 +24,10 @@ demo: build
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# ASan + UBSan and TSan builds, each running the CLI end to end (scripts/sanitize-check).
+sanitize: deps
+	scripts/sanitize-check
 
 clean:
 	rm -rf $(BUILD) $(DEMO)

@@ -116,6 +116,17 @@ int main(int argc, char** argv) {
   for (CLI::App* sub : root.get_subcommands({})) sub->fallthrough();
   vocab->fallthrough();
 
+  // An unknown command word is named (CLI11 would only say that a sub-command is required).
+  std::vector<std::string> names;
+  for (const CLI::App* sub : root.get_subcommands({})) names.push_back(sub->get_name());
+  if (argc > 1 && argv[1][0] != '-' &&
+      std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+    const auto meant = pspslam::nearest(argv[1], names);
+    std::cerr << "error: pspslam: unknown command '" << argv[1] << "'"
+              << (meant ? " (did you mean " + *meant + "?)" : std::string()) << "\n"
+              << command_list(CLI::RequiredError("command"), &root);
+    return 2;
+  }
   try {
     root.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

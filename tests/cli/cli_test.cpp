@@ -432,6 +432,10 @@ TEST(Cli, VersionQuietAndLogLevel) {
   r = pspslam("");
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.output, "commands:\n  run ")) << r.output;
+  r = pspslam("evl --gt a");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output.substr(0, r.output.find('\n')),
+            "error: pspslam: unknown command 'evl' (did you mean eval?)");
 }
 
 }  // namespace

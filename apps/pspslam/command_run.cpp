@@ -257,7 +257,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
 
   SystemOptions system_options;
   DynamicOptions& dynamic = system_options.dynamic;
-  dynamic.model = user_or_default(flags.model, source_dir() / "models/pspnet/pspnet.yaml");
+  dynamic.model = user_or_default(flags.model, data_dir() / "models/pspnet/pspnet.yaml");
   dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
 
   const std::optional<std::filesystem::path> config =

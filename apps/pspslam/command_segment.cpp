@@ -45,7 +45,7 @@ double median(std::vector<double> v) {
 }
 
 struct SegmentFlags {
-  std::string model = (source_dir() / "models" / "pspnet" / "pspnet.yaml").string();
+  std::string model = (data_dir() / "models" / "pspnet" / "pspnet.yaml").string();
   std::string images;
   std::string out;
   int limit = 0;

@@ -1,6 +1,7 @@
 #include "pspslam/core/shared_paths.h"
 
 #include <cstdlib>
+#include <system_error>
 
 namespace pspslam {
 
@@ -11,6 +12,17 @@ std::filesystem::path shared_dir() {
     return std::filesystem::path(env);
   }
   return source_dir().parent_path() / "shared";
+}
+
+std::filesystem::path data_dir() {
+  std::error_code ec;
+  const std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed =
+        executable.parent_path().parent_path() / "share" / "pspslam";
+    if (std::filesystem::is_directory(installed / "models", ec)) return installed;
+  }
+  return source_dir();
 }
 
 }  // namespace pspslam

@@ -8,7 +8,7 @@
 namespace pspslam {
 
 std::filesystem::path default_vocabulary_path() {
-  return source_dir() / "models" / "vocabulary" / "orb_k10_l5.pspvoc";
+  return data_dir() / "models" / "vocabulary" / "orb_k10_l5.pspvoc";
 }
 
 PlaceRecognition::PlaceRecognition(std::shared_ptr<const Vocabulary> vocabulary)

@@ -143,6 +143,16 @@ TEST(Config, UnknownKeyNamesFileLineAndKey) {
   EXPECT_EQ(load_error(top), top.string() + ":13: unknown key 'tracking'");
 }
 
+// Found by fuzz/fuzz_segmenter_metadata: a non-scalar key ("? [a, b]") made yaml-cpp throw
+// its own exception (exit 3) instead of a message naming the file and line.
+TEST(Config, ComplexKeyNamesFileAndLine) {
+  const auto dir = testing::make_temp_dir("config");
+  const auto file = write_file(dir, std::string(kValidCamera) + "  ? [a, b]\n  : 1\n");
+  EXPECT_EQ(load_error(file).substr(0, file.string().size() + 1), file.string() + ":");
+  EXPECT_NE(load_error(file).find(": a key must be a plain name (in 'camera')"), std::string::npos)
+      << load_error(file);
+}
+
 TEST(Config, MissingKeys) {
   const auto dir = testing::make_temp_dir("config");
   const auto no_fps = write_file(dir, replace(kValidCamera, "  fps: 30\n", ""));

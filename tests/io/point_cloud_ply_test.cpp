@@ -73,6 +73,25 @@ TEST(PointCloudPly, TruncatedFileNamesTheMissingVertices) {
       << message;
 }
 
+// Found by fuzz/fuzz_point_cloud_ply: a vertex count far beyond the file asked for an
+// impossible allocation (std::length_error, exit 3) instead of a clear error.
+TEST(PointCloudPly, ImpossibleVertexCountIsAnError) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex COUNT\nproperty float x\n"
+      "property float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+      "property uchar blue\nend_header\n";
+  const auto huge = temp_file("huge.ply");
+  std::ofstream(huge) << std::string(header).replace(header.find("COUNT"), 5,
+                                                     "18446744073709551615");
+  EXPECT_NE(error_of(huge).find("truncated: header says 18446744073709551615 vertices, file has 0"),
+            std::string::npos)
+      << error_of(huge);
+  const auto negative = temp_file("negative.ply");
+  std::ofstream(negative) << std::string(header).replace(header.find("COUNT"), 5, "-1");
+  EXPECT_NE(error_of(negative).find("bad vertex count in 'element vertex -1'"), std::string::npos)
+      << error_of(negative);
+}
+
 TEST(PointCloudPly, OtherFormatsAreRejectedWithTheReason) {
   const auto ascii = temp_file("ascii.ply");
   std::ofstream(ascii) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";

@@ -24,11 +24,21 @@ YamlSection YamlSection::section(const std::string& key) {
   return YamlSection(child, file_, qualified(key));
 }
 
+std::string YamlSection::key_name(const YAML::Node& key) const {
+  // A key may be any YAML node ("? [a, b]: 1"); ours are plain names (found by
+  // fuzz/fuzz_segmenter_metadata: converting such a key threw a yaml-cpp exception).
+  if (!key.IsScalar()) {
+    throw Error(file_ + ":" + std::to_string(key.Mark().line + 1) + ": a key must be a plain name" +
+                (path_.empty() ? "" : " (in '" + path_ + "')"));
+  }
+  return key.Scalar();
+}
+
 void YamlSection::finish() const {
   if (!node_ || !node_.IsMap()) return;
   const std::vector<std::string> valid(used_.begin(), used_.end());
   for (const auto& entry : node_) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = key_name(entry.first);
     if (!used_.count(key)) throw unknown_key(entry.first, nearest(key, valid));
   }
 }
@@ -38,7 +48,7 @@ void YamlSection::throw_missing(const std::string& key) const {
   // the key that was expected.
   if (node_ && node_.IsMap()) {
     for (const auto& entry : node_) {
-      const std::string present = entry.first.as<std::string>();
+      const std::string present = key_name(entry.first);
       if (!used_.count(present) && nearest(present, {key})) throw unknown_key(entry.first, key);
     }
   }
@@ -48,7 +58,7 @@ void YamlSection::throw_missing(const std::string& key) const {
 Error YamlSection::unknown_key(const YAML::Node& key,
                                const std::optional<std::string>& meant) const {
   return Error(file_ + ":" + std::to_string(key.Mark().line + 1) + ": unknown key '" +
-               qualified(key.as<std::string>()) + "'" +
+               qualified(key_name(key)) + "'" +
                (meant ? " (did you mean '" + qualified(*meant) + "'?)" : std::string()));
 }
 

@@ -48,6 +48,7 @@ class YamlSection {
 
  private:
   [[noreturn]] void throw_missing(const std::string& key) const;
+  std::string key_name(const YAML::Node& key) const;
   Error unknown_key(const YAML::Node& key, const std::optional<std::string>& meant) const;
 
   template <typename T>

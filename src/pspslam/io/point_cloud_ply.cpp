@@ -60,7 +60,9 @@ std::vector<ColoredPoint> read_point_cloud_ply(const std::filesystem::path& file
     if (line.rfind("comment", 0) == 0) continue;
     if (line.rfind("element vertex ", 0) == 0) {
       std::istringstream fields(line.substr(15));
-      if (!(fields >> count)) throw fail("bad vertex count in '" + line + "'");
+      std::string rest;
+      if (line.find('-') != std::string::npos || !(fields >> count) || (fields >> rest))
+        throw fail("bad vertex count in '" + line + "'");
       have_count = true;
       continue;
     }
@@ -71,6 +73,16 @@ std::vector<ColoredPoint> read_point_cloud_ply(const std::filesystem::path& file
   if (line != "end_header") throw fail("header has no end_header line");
   if (!have_count || property != kVertexProperties.size())
     throw fail("header lacks the vertex element or its properties");
+  // The count comes from the file: check it against the bytes that follow before allocating
+  // (found by fuzz/fuzz_point_cloud_ply: a huge count asked for an impossible vector).
+  const auto data_start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const auto data_bytes = static_cast<std::size_t>(in.tellg() - data_start);
+  in.seekg(data_start);
+  if (count > data_bytes / kVertexBytes) {
+    throw fail("truncated: header says " + std::to_string(count) + " vertices, file has " +
+               std::to_string(data_bytes / kVertexBytes));
+  }
   std::vector<ColoredPoint> points(count);
   std::array<char, kVertexBytes> record{};
   for (std::size_t i = 0; i < count; ++i) {

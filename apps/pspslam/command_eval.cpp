@@ -21,7 +21,11 @@ namespace {
 
 int evaluate(const EvalSettings& settings, bool json, const std::string& plot) {
   if (!plot.empty()) prepare_output_folder(plot, "--plot");
-  const Trajectory ground_truth = read_tum_trajectory(settings.ground_truth_file);
+  Trajectory ground_truth = read_tum_trajectory(settings.ground_truth_file);
+  if (!settings.gt_body_to_camera_file.empty()) {
+    ground_truth =
+        body_to_camera(ground_truth, read_rigid_transform(settings.gt_body_to_camera_file));
+  }
   const Trajectory estimate = read_tum_trajectory(settings.estimate_file);
   if (estimate.empty()) throw Error(settings.estimate_file + ": trajectory has no pose");
   if (ground_truth.empty()) throw Error(settings.ground_truth_file + ": trajectory has no pose");
@@ -64,6 +68,10 @@ Command add_eval_command(CLI::App& root) {
                   "time offset (s) added to the estimate's timestamps")
       ->check(in_range(-1e6, 1e6))
       ->capture_default_str();
+  app->add_option("--gt-body-to-camera", settings->gt_body_to_camera_file,
+                  "transform from the ground truth's body (motion-capture marker) to the camera: "
+                  "'tx ty tz qx qy qz qw' or a 4x4 matrix; the ground truth is moved onto the "
+                  "camera before comparing (default: none, as published numbers are)");
   app->add_flag("--sim3", settings->ate.sim3,
                 "align with scale (Sim(3), monocular) instead of SE(3)");
   settings->rpe.delta = 1.0;

@@ -167,6 +167,40 @@ TEST(CliEval, TableJsonAndPlots) {
   }
 }
 
+// --gt-body-to-camera moves the ground truth onto the camera. The camera turns on a circle; the
+// marker sits 0.3 m beside it, so no alignment can explain the marker's positions by the
+// camera's (ATE > 0.1 m) until the marker is moved onto the camera (ATE 0).
+TEST(CliEval, GroundTruthBodyToCamera) {
+  const auto dir = testing::make_temp_dir("cli_body");
+  Pose T_marker_camera = Pose::Identity();
+  T_marker_camera.translation() = Eigen::Vector3d(0.3, 0.0, 0.0);
+  Trajectory camera, marker;
+  for (int i = 0; i < 120; ++i) {
+    StampedPose pose;
+    pose.timestamp = 100.0 + i / 30.0;
+    const double angle = 2.0 * M_PI * i / 120.0;
+    pose.T_world_camera.linear() =
+        Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.T_world_camera.translation() = Eigen::Vector3d(std::cos(angle), std::sin(angle), 1.0);
+    camera.push_back(pose);
+    pose.T_world_camera = pose.T_world_camera * T_marker_camera.inverse();
+    marker.push_back(pose);
+  }
+  write_tum_trajectory(dir / "camera.txt", camera);
+  write_tum_trajectory(dir / "marker.txt", marker);
+  std::ofstream(dir / "marker_to_camera.txt") << "# 4x4\n1 0 0 0.3\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
+  const std::string files =
+      " --json --gt " + (dir / "marker.txt").string() + " --est " + (dir / "camera.txt").string();
+  Result r = pspslam("eval" + files);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GT(nlohmann::json::parse(r.output)["ate"]["error_m"]["rmse"].get<double>(), 0.1);
+  r = pspslam("eval" + files + " --gt-body-to-camera " + (dir / "marker_to_camera.txt").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json report = nlohmann::json::parse(r.output);
+  EXPECT_EQ(report["gt_body_to_camera"], (dir / "marker_to_camera.txt").string());
+  EXPECT_LT(report["ate"]["error_m"]["max"].get<double>(), 1e-6);
+}
+
 TEST(CliRun, MissingSequenceFlagAndConfig) {
   Result r = pspslam("run");
   EXPECT_EQ(r.status, 2);

@@ -159,3 +159,78 @@ TEST(TrajectoryWriter, UnwritableFileIsAnError) {
 
 }  // namespace
 }  // namespace pspslam
+
+namespace pspslam {
+namespace {
+
+std::filesystem::path transform_file(const std::string& name, const std::string& text) {
+  return write_text(std::filesystem::temp_directory_path() / ("pspslam_transform_" + name), text);
+}
+
+std::string transform_error(const std::filesystem::path& file) {
+  try {
+    read_rigid_transform(file);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Both forms of a transform file read to the same pose: a 90 degree turn about z and an offset.
+TEST(RigidTransform, QuaternionLineAndMatrixAgree) {
+  const double h = std::sqrt(0.5);
+  const Pose from_line = read_rigid_transform(
+      transform_file("line.txt", "# marker to camera\n0.1 -0.02 0.03 0 0 " + std::to_string(h) +
+                                     " " + std::to_string(h) + "\n"));
+  const Pose from_matrix = read_rigid_transform(
+      transform_file("matrix.txt", "0 -1 0 0.1\n1 0 0 -0.02\n0 0 1 0.03\n0 0 0 1\n"));
+  EXPECT_TRUE(from_line.isApprox(from_matrix, 1e-6));
+  EXPECT_NEAR(from_matrix.translation().x(), 0.1, 1e-12);
+  EXPECT_NEAR((from_matrix.linear() * Eigen::Vector3d::UnitX()).y(), 1.0, 1e-12);
+}
+
+TEST(RigidTransform, BadFilesNameTheProblem) {
+  auto file = transform_file("five.txt", "1 2 3 4 5\n");
+  EXPECT_EQ(transform_error(file),
+            file.string() +
+                ": expected 'tx ty tz qx qy qz qw' on one line or a 4x4 matrix (4 lines of 4 "
+                "numbers), got 1 lines");
+  file = transform_file("scaled.txt", "2 0 0 0\n0 2 0 0\n0 0 2 0\n0 0 0 1\n");
+  EXPECT_EQ(transform_error(file).substr(0, file.string().size() + 32),
+            file.string() + ": the 3x3 part is not a rotation");
+  file = transform_file("row.txt", "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 1 1\n");
+  EXPECT_EQ(transform_error(file),
+            file.string() + ":4: the last row of a rigid transform is 0 0 0 1");
+  file = transform_file("quat.txt", "0 0 0 0 0 0 2\n");
+  EXPECT_EQ(transform_error(file),
+            file.string() +
+                ":1: quaternion (qx qy qz qw) has norm 2.000000, expected a unit "
+                "quaternion");
+}
+
+// A marker 10 cm beside the camera: moving the ground truth onto the camera recovers the
+// camera's trajectory exactly.
+TEST(RigidTransform, BodyToCameraMovesEveryPose) {
+  Trajectory camera;
+  Pose T_body_camera = Pose::Identity();
+  T_body_camera.translation() = Eigen::Vector3d(0.1, 0.0, 0.0);
+  T_body_camera.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  Trajectory marker;
+  for (int i = 0; i < 5; ++i) {
+    StampedPose pose;
+    pose.timestamp = i;
+    pose.T_world_camera.linear() =
+        Eigen::AngleAxisd(0.2 * i, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.T_world_camera.translation() = Eigen::Vector3d(i, 0.5 * i, 1.0);
+    camera.push_back(pose);
+    pose.T_world_camera = pose.T_world_camera * T_body_camera.inverse();
+    marker.push_back(pose);
+  }
+  const Trajectory moved = body_to_camera(marker, T_body_camera);
+  ASSERT_EQ(moved.size(), camera.size());
+  for (size_t i = 0; i < moved.size(); ++i)
+    EXPECT_TRUE(moved[i].T_world_camera.isApprox(camera[i].T_world_camera, 1e-12)) << i;
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -43,7 +43,11 @@ std::string table_row(const std::string& name, const std::string& unit, const Er
 std::string format_eval_table(const EvalSettings& settings, const AteResult& ate,
                               const RpeResult& rpe) {
   std::ostringstream out;
-  out << "ground truth: " << settings.ground_truth_file << "\n";
+  out << "ground truth: " << settings.ground_truth_file
+      << (settings.gt_body_to_camera_file.empty()
+              ? std::string()
+              : " (moved to the camera by " + settings.gt_body_to_camera_file + ")")
+      << "\n";
   out << "estimate:     " << settings.estimate_file << "\n";
   out << "association:  max dt " << short_number(settings.ate.max_difference) << " s, offset "
       << short_number(settings.ate.offset) << " s\n";
@@ -78,6 +82,9 @@ std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
   const nlohmann::ordered_json report = {
       {"ground_truth", settings.ground_truth_file},
       {"estimate", settings.estimate_file},
+      {"gt_body_to_camera", settings.gt_body_to_camera_file.empty()
+                                ? nlohmann::ordered_json(nullptr)
+                                : nlohmann::ordered_json(settings.gt_body_to_camera_file)},
       {"ate",
        {{"alignment", settings.ate.sim3 ? "sim3" : "se3"},
         {"max_dt_s", settings.ate.max_difference},

@@ -11,6 +11,9 @@ namespace pspslam {
 struct EvalSettings {
   std::string ground_truth_file;
   std::string estimate_file;
+  // --gt-body-to-camera: file of the transform from the ground truth's body (a motion-capture
+  // marker) to the camera; empty: the ground truth is taken as the camera's pose.
+  std::string gt_body_to_camera_file;
   AteOptions ate;
   RpeOptions rpe;
 };

@@ -1,5 +1,7 @@
 #include "pspslam/io/trajectory_io.h"
 
+#include <Eigen/SVD>
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -52,6 +54,67 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
     trajectory.push_back(pose);
   });
   return trajectory;
+}
+
+Pose read_rigid_transform(const std::filesystem::path& file) {
+  std::vector<std::vector<double>> rows;
+  std::vector<size_t> row_lines;
+  for_each_data_line(file, "transform file", [&](const TextLine& line) {
+    std::vector<double> row;
+    for (size_t i = 0; i < line.fields.size(); ++i) {
+      row.push_back(
+          parse_number(line.fields[i], file, line.line, "value " + std::to_string(i + 1)));
+    }
+    rows.push_back(std::move(row));
+    row_lines.push_back(line.line);
+  });
+  const std::string form =
+      "expected 'tx ty tz qx qy qz qw' on one line or a 4x4 matrix (4 lines of 4 numbers)";
+  Pose pose = Pose::Identity();
+  if (rows.size() == 1 && rows[0].size() == 7) {
+    const std::vector<double>& v = rows[0];
+    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+    if (!(std::abs(q.norm() - 1.0) <= kQuaternionNormTolerance)) {
+      throw Error(line_prefix(file, row_lines[0]) + "quaternion (qx qy qz qw) has norm " +
+                  format_number(q.norm(), 6) + ", expected a unit quaternion");
+    }
+    pose.linear() = q.normalized().toRotationMatrix();
+    pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    return pose;
+  }
+  if (rows.size() != 3 && rows.size() != 4) {
+    throw Error(file.string() + ": " + form + ", got " + std::to_string(rows.size()) + " lines");
+  }
+  Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (rows[r].size() != 4) {
+      throw Error(line_prefix(file, row_lines[r]) + form + ", got " +
+                  std::to_string(rows[r].size()) + " numbers on this line");
+    }
+    for (size_t c = 0; c < 4; ++c) matrix(static_cast<int>(r), static_cast<int>(c)) = rows[r][c];
+  }
+  if (rows.size() == 4 && !matrix.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) {
+    throw Error(line_prefix(file, row_lines[3]) + "the last row of a rigid transform is 0 0 0 1");
+  }
+  const Eigen::Matrix3d rotation = matrix.topLeftCorner<3, 3>();
+  const double orthonormal_error =
+      (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(orthonormal_error <= 1e-3) || !(rotation.determinant() > 0.0)) {
+    throw Error(file.string() + ": the 3x3 part is not a rotation (R^T R differs from I by " +
+                format_number(orthonormal_error, 6) + ", det " +
+                format_number(rotation.determinant(), 6) + ")");
+  }
+  // Re-orthonormalise: 4-digit matrices are rotations only up to rounding.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(rotation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  pose.linear() = svd.matrixU() * svd.matrixV().transpose();
+  pose.translation() = matrix.topRightCorner<3, 1>();
+  return pose;
+}
+
+Trajectory body_to_camera(const Trajectory& ground_truth, const Pose& T_body_camera) {
+  Trajectory camera = ground_truth;
+  for (StampedPose& pose : camera) pose.T_world_camera = pose.T_world_camera * T_body_camera;
+  return camera;
 }
 
 std::string format_tum_pose(const StampedPose& pose) {

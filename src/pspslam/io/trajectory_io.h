@@ -22,6 +22,15 @@ inline constexpr double kQuaternionNormTolerance = 1e-3;
 // "... quaternion ... has norm X, expected a unit quaternion", "... timestamp ... repeats line N".
 Trajectory read_tum_trajectory(const std::filesystem::path& file);
 
+// Reads one rigid transform: either 7 numbers `tx ty tz qx qy qz qw` (one line) or a 4x4
+// matrix (4 lines of 4 numbers, last row 0 0 0 1; a 3x4 matrix is accepted too), `#` comments
+// ignored. The rotation must be orthonormal within 1e-3. Errors name the file and line.
+Pose read_rigid_transform(const std::filesystem::path& file);
+
+// The ground truth of the camera when `ground_truth` tracks another body (a motion-capture
+// marker): every pose becomes T_world_body * T_body_camera.
+Trajectory body_to_camera(const Trajectory& ground_truth, const Pose& T_body_camera);
+
 // One TUM line (no newline); every number in its shortest exact form, so reading the line back
 // gives the same doubles (timestamps bit-exact; the pose up to the quaternion conversion).
 std::string format_tum_pose(const StampedPose& pose);

@@ -143,6 +143,18 @@ TEST(RgbdSequence, MissingFilesSkipFramesWithOneWarning) {
   EXPECT_EQ(sequence.load(1).index, 1u);
 }
 
+// Found by fuzz/fuzz_sequence_lists: a listed file name too long for the file system made
+// std::filesystem::exists throw (exit 3); it is a missing file like any other.
+TEST(RgbdSequence, UnlookupableFileNameIsAMissingFile) {
+  const auto dir = testing::make_temp_dir("sequence_long_name");
+  const std::string long_name(5000, 'c');
+  std::ofstream(dir / "rgb.txt") << "1.0 " << long_name << "\n";
+  std::ofstream(dir / "depth.txt") << "1.0 " << long_name << "\n";
+  EXPECT_EQ(open_error(dir), dir.string() +
+                                 ": no RGB-D frame: 1 colour and 1 depth files listed, none "
+                                 "associated within 0.020000 s with both files present");
+}
+
 TEST(RgbdSequence, MalformedListLinesNameFileAndLine) {
   const auto dir = make_sequence("seq");
   write_text(dir / "rgb.txt", "# header\n10.0000 rgb/10.0000.png\n10.1000\n");

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <ostream>
+#include <system_error>
 #include <unordered_map>
 
 #include "pspslam/core/error.h"
@@ -170,14 +171,19 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
     }
   }
 
+  // A listed name the file system cannot even look up (too long, say) is a missing file, not an
+  // exception (found by fuzz/fuzz_sequence_lists).
+  const auto present = [&](const std::string& file) {
+    std::error_code ec;
+    return std::filesystem::exists(dir / file, ec) && !ec;
+  };
   std::string first_missing;
   for (const std::string& file : listed_files) {
-    if (std::filesystem::exists(dir / file)) continue;
+    if (present(file)) continue;
     if (sequence.missing_files_++ == 0) first_missing = file;
   }
   for (FrameFiles& frame : associated) {
-    if (sequence.missing_files_ > 0 && (!std::filesystem::exists(dir / frame.rgb_file) ||
-                                        !std::filesystem::exists(dir / frame.depth_file))) {
+    if (sequence.missing_files_ > 0 && (!present(frame.rgb_file) || !present(frame.depth_file))) {
       ++sequence.skipped_frames_;
       continue;
     }

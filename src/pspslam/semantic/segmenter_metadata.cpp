@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <system_error>
 
 #include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
@@ -87,7 +88,8 @@ SegmenterMetadata load_segmenter_metadata(const std::filesystem::path& file) {
   class_ids(meta.classes, meta.dynamic_classes, file.string() + ": dynamic_classes");
 
   meta.onnx = resolve_onnx(file, onnx);
-  if (!std::filesystem::is_regular_file(meta.onnx)) {
+  std::error_code ec;  // a name the file system cannot look up (too long) does not exist either
+  if (!std::filesystem::is_regular_file(meta.onnx, ec)) {
     throw Error(where + "onnx file '" + meta.onnx.string() + "' (key 'onnx') does not exist");
   }
   return meta;

@@ -297,7 +297,9 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
               << "\n";
   }
   system_options.place.vocabulary = user_or_default(flags.vocabulary, default_vocabulary_path());
+  // Localisation never changes the map, so it never closes loops (System turns it off too).
   system_options.place.loop_closing =
+      !system_options.localization_only &&
       parse_loop_closing(flags.loop_closing, system_options.place.vocabulary);
   std::cout << "loop closing: " << (system_options.place.loop_closing ? "on" : "off") << "\n";
   System system(setup.config, system_options);

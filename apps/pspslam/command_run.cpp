@@ -306,7 +306,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   std::optional<MapExporter> exporter;
   if (!flags.export_map.empty() || !flags.export_dense.empty()) exporter.emplace(camera);
   InterruptGuard interrupt_guard;
-  ProgressBar progress("slam", frames, std::cerr, !global.quiet);
+  ProgressBar progress("slam", frames, std::cerr, !global.quiet, flags.realtime);
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;
   std::vector<double> tracking_cpu_ms;
@@ -443,7 +443,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     masked_keypoints += dyn.masked_keypoints;
     culled_points += dyn.culled_map_points;
     ++processed;
-    progress.update(processed);
+    progress.update(processed, realtime_dropped);
   }
   progress.finish();
   system.shutdown();

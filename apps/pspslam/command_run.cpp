@@ -297,14 +297,16 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
               << "\n";
   }
   system_options.place.vocabulary = user_or_default(flags.vocabulary, default_vocabulary_path());
+  // Localisation never changes the map, so it never closes loops (System turns it off too).
   system_options.place.loop_closing =
+      !system_options.localization_only &&
       parse_loop_closing(flags.loop_closing, system_options.place.vocabulary);
   std::cout << "loop closing: " << (system_options.place.loop_closing ? "on" : "off") << "\n";
   System system(setup.config, system_options);
   std::optional<MapExporter> exporter;
   if (!flags.export_map.empty() || !flags.export_dense.empty()) exporter.emplace(camera);
   InterruptGuard interrupt_guard;
-  ProgressBar progress("slam", frames, std::cerr, !global.quiet);
+  ProgressBar progress("slam", frames, std::cerr, !global.quiet, flags.realtime);
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;
   std::vector<double> tracking_cpu_ms;
@@ -441,7 +443,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     masked_keypoints += dyn.masked_keypoints;
     culled_points += dyn.culled_map_points;
     ++processed;
-    progress.update(processed);
+    progress.update(processed, realtime_dropped);
   }
   progress.finish();
   system.shutdown();

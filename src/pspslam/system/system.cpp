@@ -60,6 +60,7 @@
 
 #include "pspslam/dynamic/frame_flow.h"
 #include "pspslam/dynamic/keypoint_fusion.h"
+#include "pspslam/dynamic/map_reference_views.h"
 #include "pspslam/dynamic/mask_warper.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/geometry/compensated_homography.h"
@@ -227,18 +228,14 @@ class System::DynamicPipeline {
                       DynamicReport& report) {
     geometry_mask_.release();
     const std::vector<std::uint8_t>* geometry_flags = nullptr;
-    if (geometry_ && prior_pose() && !references_.empty()) {
+    if (geometry_ && prior_pose()) collect_reference_views();
+    if (geometry_ && prior_pose() && !views_.empty()) {
       const auto start = std::chrono::steady_clock::now();
       pixels_.resize(features.keypoints.size());
       // Distorted pixel positions: the depth image is registered to the distorted image, and
       // the lens distortion of Kinect-class presets moves pixels by less than the test's patch.
       for (size_t i = 0; i < features.keypoints.size(); ++i)
         pixels_[i] = {features.keypoints[i].pt.x, features.keypoints[i].pt.y};
-      views_.clear();
-      for (const auto& reference : references_) {
-        if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
-          views_.push_back({keyframe->T_world_camera(), reference.depth});
-      }
       GeometryFrameInput input;
       input.depth = depth;
       input.T_world_camera = *prior_pose();
@@ -271,6 +268,14 @@ class System::DynamicPipeline {
     for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
   }
 
+  // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
+  // culled, and the geometry stage takes its reference views from the map's keyframes since
+  // the run inserts none. Call after the map is loaded.
+  void use_loaded_map_only() {
+    protect_map_ = true;
+    if (geometry_) map_references_.emplace(map_, camera_);
+  }
+
   // The map was corrected under the last tracked pose (loop closing): take the corrected one.
   void reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
     if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
@@ -301,7 +306,7 @@ class System::DynamicPipeline {
       }
       last_pose_ = result.T_world_camera;
       last_pose_id_ = current_id_;
-      if (!previous_mask_.empty()) {
+      if (!previous_mask_.empty() && !protect_map_) {
         const auto points = map_.reference_map_points();
         const auto& culled =
             culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
@@ -347,6 +352,22 @@ class System::DynamicPipeline {
     return warped.mask;
   }
 
+  // The geometry stage's reference pool: the depth images of this run's newest keyframes, or in
+  // localisation the loaded map's keyframes nearest the pose prior.
+  void collect_reference_views() {
+    views_.clear();
+    const size_t pool_size =
+        kReferencePoolFactor * static_cast<size_t>(options_.geometry.multiview.max_reference_views);
+    if (map_references_) {
+      map_references_->pool(*prior_pose(), pool_size, views_);
+      return;
+    }
+    for (const auto& reference : references_) {
+      if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
+        views_.push_back({keyframe->T_world_camera(), reference.depth});
+    }
+  }
+
   std::optional<Pose> prior_pose() const {
     if (!last_pose_ || last_pose_id_ + 1 != current_id_) return std::nullopt;
     // Constant velocity, as tracking's own motion model.
@@ -370,7 +391,9 @@ class System::DynamicPipeline {
   std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
   std::int64_t current_id_ = 0;
   std::deque<Submitted> submitted_;
-  std::deque<Reference> references_;  // newest keyframe first
+  std::deque<Reference> references_;                 // newest keyframe first
+  std::optional<MapReferenceViews> map_references_;  // localisation only
+  bool protect_map_ = false;                         // localisation: never erase map points
   std::optional<Eigen::Matrix3d> H_previous_to_current_;
   cv::Mat previous_gray_;
   cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
@@ -449,8 +472,10 @@ System::System(const SystemConfig& config, SystemOptions options)
           loop->insert_keyframe(keyframe);
         });
   }
-  if (options.dynamic.mode != DynamicMode::off)
+  if (options.dynamic.mode != DynamicMode::off) {
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
+    if (options.localization_only) dynamic_->use_loaded_map_only();
+  }
 }
 
 System::~System() { shutdown(); }

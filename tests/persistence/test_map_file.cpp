@@ -4,6 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -64,8 +66,8 @@ class MapFileTest : public ::testing::Test {
     // The live map, to compare the loaded one with.
     for (const auto& keyframe : system.map().keyframes()) {
       live_keyframes_.push_back(
-          {keyframe->T_camera_world(), keyframe->size(), keyframe->tracked_map_points(1),
-           keyframe->covisibles().size(),
+          {keyframe->id(), keyframe->T_camera_world(), keyframe->size(),
+           keyframe->tracked_map_points(1), keyframe->covisibles().size(),
            keyframe->parent() ? static_cast<int>(keyframe->parent()->id()) : -1});
     }
   }
@@ -102,6 +104,7 @@ class MapFileTest : public ::testing::Test {
   }
 
   struct LiveKeyFrame {
+    std::uint64_t id;
     Pose T_camera_world;
     int keypoints;
     int points;
@@ -130,8 +133,15 @@ TEST_F(MapFileTest, LoadRebuildsTheSameKeyframesPointsAndGraph) {
   ASSERT_EQ(keyframes.size(), live_keyframes_.size());
   ASSERT_GE(keyframes.size(), 3u);
   EXPECT_EQ(map.num_map_points(), points_saved_);
+  // Keyframes and points made after loading get new ids.
+  EXPECT_GT(map.next_keyframe_id(), keyframes.back()->id());
+  std::uint64_t max_point_id = 0;
+  for (const auto& point : map.map_points()) max_point_id = std::max(max_point_id, point->id());
+  EXPECT_GT(map.next_map_point_id(), max_point_id);
   for (size_t k = 0; k < keyframes.size(); ++k) {
     const LiveKeyFrame& live = live_keyframes_[k];
+    // Ids as saved (the live map has gaps where local mapping culled keyframes).
+    EXPECT_EQ(keyframes[k]->id(), live.id) << "keyframe " << k;
     EXPECT_TRUE(keyframes[k]->T_camera_world().isApprox(live.T_camera_world, 1e-12))
         << "keyframe " << k;
     EXPECT_EQ(keyframes[k]->size(), live.keypoints) << "keyframe " << k;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <map>
@@ -23,6 +24,12 @@ class Map {
 
   std::uint64_t next_keyframe_id() { return next_keyframe_id_++; }
   std::uint64_t next_map_point_id() { return next_map_point_id_++; }
+  // After a map is loaded with the ids it was saved with: ids handed out from now on are larger
+  // than the loaded ones.
+  void continue_ids_after(std::uint64_t keyframe_id, std::uint64_t map_point_id) {
+    next_keyframe_id_ = std::max<std::uint64_t>(next_keyframe_id_, keyframe_id + 1);
+    next_map_point_id_ = std::max<std::uint64_t>(next_map_point_id_, map_point_id + 1);
+  }
 
   void add_keyframe(const std::shared_ptr<KeyFrame>& keyframe);
   void add_map_point(const std::shared_ptr<MapPoint>& point);

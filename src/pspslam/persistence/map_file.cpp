@@ -1,5 +1,6 @@
 #include "pspslam/persistence/map_file.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -366,12 +367,18 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
   // The file is consistent: build the map.
   if (map.num_keyframes() != 0 || map.num_map_points() != 0)
     throw Error(prefix + "cannot load into a map that already has keyframes or points");
+  // Keyframes and points keep the ids they were saved with (the file is in ascending id order),
+  // so a map loaded and saved again without change is the same file byte for byte (localisation
+  // promises not to change the map); new ids continue after the largest loaded ones.
   std::lock_guard lock(map.update_mutex());
+  std::uint64_t max_point_id = 0;
+  for (const PointRecord& record : point_records) max_point_id = std::max(max_point_id, record.id);
+  map.continue_ids_after(keyframe_records.empty() ? 0 : keyframe_records.back().id, max_point_id);
   std::vector<std::shared_ptr<KeyFrame>> keyframes;
   keyframes.reserve(keyframe_records.size());
   for (KeyFrameRecord& record : keyframe_records) {
-    keyframes.push_back(std::make_shared<KeyFrame>(map.next_keyframe_id(), std::move(record.data),
-                                                   camera, pyramid));
+    keyframes.push_back(
+        std::make_shared<KeyFrame>(record.id, std::move(record.data), camera, pyramid));
     map.add_keyframe(keyframes.back());
   }
   std::vector<std::shared_ptr<MapPoint>> points;
@@ -380,8 +387,7 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
     const auto reference = keyframe_index.find(record.reference_keyframe);
     const std::shared_ptr<KeyFrame>& reference_keyframe =
         keyframes[reference != keyframe_index.end() ? reference->second : 0];
-    auto point =
-        std::make_shared<MapPoint>(map.next_map_point_id(), record.position, reference_keyframe);
+    auto point = std::make_shared<MapPoint>(record.id, record.position, reference_keyframe);
     const auto first = keyframe_index.find(record.first_keyframe);
     point->first_keyframe_id = first != keyframe_index.end() ? keyframes[first->second]->id() : 0;
     points.push_back(point);

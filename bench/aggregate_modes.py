@@ -5,17 +5,21 @@ Reads WORK/runs/<sequence>/<mode>/run<k>/{stats.json,eval.json} and writes
   RESULTS/modes.json   every run and the per sequence x mode summary (machine-readable)
   RESULTS/modes.csv    one row per run
   RESULTS/modes.md     the section for docs/benchmarks.md
-  DOCS/modes_ate_bars.svg (+ .png when ImageMagick `convert` is available): ATE statistics
+  DOCS/modes_ate_bars.{svg,png}: ATE statistics (the PNG rendered from the SVG by rsvg-convert,
+      librsvg2-bin; without it the PNG has the bars only). --bars-from-results redraws just these
+      two from RESULTS/modes.json.
   DOCS/modes_trajectories/<sequence>_<mode>.png: run 1's trajectory_refined.txt against ground truth (`pspslam eval --plot`)
 Only measured values are written; a sequence x mode without runs is listed as missing.
 """
 import argparse
 import json
+import math
 import shutil
 import struct
 import zlib
 import statistics
 import subprocess
+import sys
 from pathlib import Path
 
 MODES = ["off", "semantic", "geometry", "full", "exhaustive"]
@@ -89,14 +93,101 @@ def fmt(value, digits=4):
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def rasterise(svg_file, png_file, width, height, rects):
+    """PNG twin of a labelled SVG: rendered by librsvg's rsvg-convert (text included) when it is
+    installed (Debian: librsvg2-bin); otherwise the bars alone, drawn here, with a warning."""
+    tool = shutil.which("rsvg-convert")
+    if tool and subprocess.run([tool, "--background-color", "white", "-w", str(width), "-h",
+                                str(height), "-o", str(png_file), str(svg_file)],
+                               capture_output=True).returncode == 0:
+        return True
+    print(f"warning: rsvg-convert not found (apt-get install librsvg2-bin): {png_file} has the "
+          "bars but no text; the SVG is labelled", file=sys.stderr)
+    write_png(png_file, width, height, rects)
+    return False
+
+
+def draw_ate_bars(table, sequences, docs):
+    """DOCS/modes_ate_bars.svg and .png: the final trajectory's ATE RMSE per sequence and mode
+    (bar = median over runs, whisker = min..max, value in mm above each bar)."""
+    width, height, left, bottom, top = 900, 440, 80, 80, 50
+    best = 1.1 * max([((row["ate_refined_rmse_m"] or {}).get("max") or 0) for row in table.values()] + [1e-3])
+    best_mm = 1000.0 * best
+    scale = (height - bottom - top) / best_mm
+    font = 'font-family="DejaVu Sans, sans-serif"'
+    svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" {font}>',
+           f'<rect width="{width}" height="{height}" fill="white"/>',
+           f'<text x="{width / 2}" y="20" text-anchor="middle" font-size="15">ATE RMSE of trajectory_refined.txt per sequence and dynamic mode</text>',
+           f'<text x="{width / 2}" y="38" text-anchor="middle" font-size="11">bar = median over runs, whisker = min..max, value = median in mm (bench/run_modes.sh, bench/results/modes.json)</text>']
+    rects = []
+    # Ticks at 1, 2 or 5 times a power of ten, about five of them.
+    raw = best_mm / 5
+    power = 10 ** math.floor(math.log10(raw))
+    step = next(f * power for f in (1, 2, 5, 10) if f * power >= raw)
+    for k in range(int(best_mm // step) + 1):
+        value = k * step
+        y = height - bottom - value * scale
+        svg.append(f'<text x="{left - 6}" y="{y + 4:.1f}" text-anchor="end" font-size="11">{value:.0f}</text>')
+        svg.append(f'<line x1="{left}" y1="{y:.1f}" x2="{width - 10}" y2="{y:.1f}" stroke="#dddddd"/>')
+        rects.append((left, y, width - 10, y + 1, "#dddddd"))
+    svg.append(f'<line x1="{left}" y1="{height - bottom}" x2="{width - 10}" y2="{height - bottom}" stroke="black"/>')
+    svg.append(f'<line x1="{left}" y1="{top}" x2="{left}" y2="{height - bottom}" stroke="black"/>')
+    rects += [(left, height - bottom, width - 10, height - bottom + 1, "#000000"),
+              (left, top, left + 1, height - bottom, "#000000")]
+    svg.append(f'<text x="22" y="{(top + height - bottom) / 2}" text-anchor="middle" font-size="12" transform="rotate(-90 22 {(top + height - bottom) / 2})">ATE RMSE [mm]</text>')
+    svg.append(f'<text x="{(left + width - 10) / 2}" y="{height - 34}" text-anchor="middle" font-size="12">sequence</text>')
+    group_width = (width - left - 20) / max(1, len(sequences))
+    bar = group_width / (len(MODES) + 1)
+    for g, seq in enumerate(sequences):
+        x0 = left + 10 + g * group_width
+        svg.append(f'<text x="{x0 + group_width / 2 - bar / 2:.1f}" y="{height - bottom + 18}" text-anchor="middle" font-size="12">{seq}</text>')
+        for m, mode in enumerate(MODES):
+            row = table.get(f"{seq}/{mode}")
+            if not row or not row["ate_refined_rmse_m"]:
+                continue
+            a = {k: 1000.0 * v for k, v in row["ate_refined_rmse_m"].items() if k != "runs"}
+            x = x0 + m * bar
+            y = height - bottom - a["median"] * scale
+            svg.append(f'<rect x="{x:.1f}" y="{y:.1f}" width="{bar * 0.9:.1f}" height="{a["median"] * scale:.1f}" fill="{COLOURS[mode]}"/>')
+            rects.append((x, y, x + bar * 0.9, height - bottom, COLOURS[mode]))
+            cx = x + bar * 0.45
+            rects.append((cx, height - bottom - a["max"] * scale, cx + 1,
+                          height - bottom - a["min"] * scale + 1, "#000000"))
+            svg.append(f'<line x1="{cx:.1f}" y1="{height - bottom - a["min"] * scale:.1f}" x2="{cx:.1f}" y2="{height - bottom - a["max"] * scale:.1f}" stroke="black"/>')
+            label_y = min(y, height - bottom - a["max"] * scale) - 4
+            svg.append(f'<text x="{cx:.1f}" y="{label_y:.1f}" text-anchor="middle" font-size="10">{a["median"]:.1f}</text>')
+    for m, mode in enumerate(MODES):
+        svg.append(f'<rect x="{left + 10 + m * 130}" y="{height - 22}" width="12" height="12" fill="{COLOURS[mode]}"/>')
+        rects.append((left + 10 + m * 130, height - 22, left + 22 + m * 130, height - 10, COLOURS[mode]))
+        svg.append(f'<text x="{left + 26 + m * 130}" y="{height - 12}" font-size="12">{mode}</text>')
+    svg.append("</svg>")
+    (docs / "modes_ate_bars.svg").write_text("\n".join(svg) + "\n")
+    labelled = rasterise(docs / "modes_ate_bars.svg", docs / "modes_ate_bars.png", width, height, rects)
+    return ["docs/modes_ate_bars.svg",
+            "docs/modes_ate_bars.png" + ("" if labelled else " (bars only: no rsvg-convert)")]
+
+
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("--work", required=True)
-    parser.add_argument("--cli", required=True)
+    parser.add_argument("--work")
+    parser.add_argument("--cli")
     parser.add_argument("--results", required=True)
     parser.add_argument("--docs", required=True)
     parser.add_argument("--sequence-dirs", default="")
+    parser.add_argument("--bars-from-results", action="store_true",
+                        help="only redraw DOCS/modes_ate_bars.{svg,png} from RESULTS/modes.json "
+                             "(no runs needed)")
     args = parser.parse_args()
+    if args.bars_from_results:
+        summary_table = json.loads(Path(args.results, "modes.json").read_text())["summary"]
+        docs = Path(args.docs)
+        docs.mkdir(parents=True, exist_ok=True)
+        print("\n".join(draw_ate_bars(summary_table,
+                                      sorted({row["sequence"] for row in summary_table.values()}),
+                                      docs)))
+        return
+    if not args.work or not args.cli:
+        parser.error("--work and --cli are required (unless --bars-from-results)")
     sequence_dirs = dict(item.split("=", 1) for item in args.sequence_dirs.split() if "=" in item)
 
     runs = collect(args.work)
@@ -198,54 +289,8 @@ def main():
                       f"{fmt((t.get('geometry') or {}).get('median'), 1)} | "
                       f"{fmt((row['ate_refined_rmse_m'] or {}).get('median'))} |")
 
-    # ATE bar chart (SVG written by hand; PNG through ImageMagick when present).
-    width, height, left, bottom, top = 900, 420, 70, 60, 30
-    groups = [s for s in sequences]
-    best = 1.1 * max([((row["ate_refined_rmse_m"] or {}).get("max") or 0) for row in table.values()] + [1e-3])
-    scale = (height - bottom - top) / best
-    svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}">',
-           f'<rect width="{width}" height="{height}" fill="white"/>',
-           f'<text x="{width / 2}" y="18" text-anchor="middle" font-size="14">ATE RMSE of trajectory_refined.txt per sequence and mode (bar = median, line = min..max over runs)</text>',
-           f'<line x1="{left}" y1="{height - bottom}" x2="{width - 10}" y2="{height - bottom}" stroke="black"/>',
-           f'<line x1="{left}" y1="{top}" x2="{left}" y2="{height - bottom}" stroke="black"/>']
-    rects = [(left, height - bottom, width - 10, height - bottom + 1, "#000000"),
-             (left, top, left + 1, height - bottom, "#000000")]
-    for k in range(5):
-        value = best * k / 4
-        y = height - bottom - value * scale
-        svg.append(f'<text x="{left - 5}" y="{y + 4}" text-anchor="end" font-size="11">{value:.3f}</text>')
-        svg.append(f'<line x1="{left}" y1="{y}" x2="{width - 10}" y2="{y}" stroke="#dddddd"/>')
-        rects.append((left, y, width - 10, y + 1, "#dddddd"))
-    svg.append(f'<text x="15" y="{height / 2}" font-size="12" transform="rotate(-90 15 {height / 2})">ATE RMSE [m]</text>')
-    group_width = (width - left - 20) / max(1, len(groups))
-    bar = group_width / (len(MODES) + 1)
-    for g, seq in enumerate(groups):
-        x0 = left + 10 + g * group_width
-        svg.append(f'<text x="{x0 + group_width / 2 - bar / 2}" y="{height - bottom + 18}" text-anchor="middle" font-size="12">{seq}</text>')
-        for m, mode in enumerate(MODES):
-            row = table.get(f"{seq}/{mode}")
-            if not row or not row["ate_refined_rmse_m"]:
-                continue
-            a = row["ate_refined_rmse_m"]
-            x = x0 + m * bar
-            y = height - bottom - a["median"] * scale
-            svg.append(f'<rect x="{x:.1f}" y="{y:.1f}" width="{bar * 0.9:.1f}" height="{a["median"] * scale:.1f}" fill="{COLOURS[mode]}"/>')
-            rects.append((x, y, x + bar * 0.9, height - bottom, COLOURS[mode]))
-            cx = x + bar * 0.45
-            rects.append((cx, height - bottom - a["max"] * scale, cx + 1,
-                          height - bottom - a["min"] * scale + 1, "#000000"))
-            svg.append(f'<line x1="{cx:.1f}" y1="{height - bottom - a["min"] * scale:.1f}" x2="{cx:.1f}" y2="{height - bottom - a["max"] * scale:.1f}" stroke="black"/>')
-    for m, mode in enumerate(MODES):
-        svg.append(f'<rect x="{left + 10 + m * 130}" y="{height - 25}" width="12" height="12" fill="{COLOURS[mode]}"/>')
-        rects.append((left + 10 + m * 130, height - 25, left + 22 + m * 130, height - 13, COLOURS[mode]))
-        svg.append(f'<text x="{left + 26 + m * 130}" y="{height - 15}" font-size="12">{mode}</text>')
-    svg.append("</svg>")
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / "modes_ate_bars.svg").write_text("\n".join(svg))
-    write_png(docs / "modes_ate_bars.png", width, height, rects)
-    images = ["docs/modes_ate_bars.svg (labelled)",
-              "docs/modes_ate_bars.png (same bars, unlabelled; colours: " +
-              ", ".join(f"{m} {c}" for m, c in COLOURS.items()) + ")"]
+    images = draw_ate_bars(table, sequences, docs)
 
     # Trajectory overlays of run 1's final trajectory (paper Fig. 7-9).
     plots = docs / "modes_trajectories"

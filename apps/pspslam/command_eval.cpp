@@ -1,5 +1,11 @@
 // `pspslam eval`: ATE and RPE of an estimated trajectory, as TUM's evaluate_ate.py /
 // evaluate_rpe.py compute them; the numerics live in pspslam_eval.
+#include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -19,7 +25,44 @@ namespace pspslam::cli {
 
 namespace {
 
-int evaluate(const EvalSettings& settings, bool json, const std::string& plot) {
+// Names the run in plot titles: `--title` when given; else "<sequence folder>, mode <mode>" from
+// the stats.json that `pspslam run` writes beside its trajectories; else nothing. A stats.json
+// that does not parse only loses the name (the evaluation itself does not need it).
+std::string plot_run_name(const std::string& title, const std::string& estimate_file) {
+  if (!title.empty()) return title;
+  const std::filesystem::path stats_file =
+      std::filesystem::path(estimate_file).parent_path() / "stats.json";
+  std::error_code failure;
+  if (!std::filesystem::is_regular_file(stats_file, failure)) return {};
+  try {
+    std::ifstream stream(stats_file);
+    const nlohmann::json stats = nlohmann::json::parse(stream);
+    std::string name;
+    if (stats.contains("sequence") && stats["sequence"].is_string()) {
+      // `run` records the sequence folder; its last component names the sequence.
+      std::filesystem::path sequence = stats["sequence"].get<std::string>();
+      if (!sequence.has_filename()) sequence = sequence.parent_path();
+      name = sequence.filename().string();
+    }
+    if (stats.contains("mode") && stats["mode"].is_string()) {
+      name += (name.empty() ? "" : ", ") + std::string("mode ") + stats["mode"].get<std::string>();
+    }
+    return name;
+  } catch (const nlohmann::json::exception& e) {
+    spdlog::warn("{}: not read for the plot titles: {}", stats_file.string(), e.what());
+    return {};
+  }
+}
+
+std::string rpe_delta_text(const RpeOptions& rpe) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%g %s", rpe.delta,
+                rpe.unit == RpeDeltaUnit::seconds ? "s" : "frames");
+  return buffer;
+}
+
+int evaluate(const EvalSettings& settings, bool json, const std::string& plot,
+             const std::string& title) {
   if (!plot.empty()) prepare_output_folder(plot, "--plot");
   Trajectory ground_truth = read_tum_trajectory(settings.ground_truth_file);
   if (!settings.gt_body_to_camera_file.empty()) {
@@ -35,11 +78,16 @@ int evaluate(const EvalSettings& settings, bool json, const std::string& plot) {
   std::cout << (json ? format_eval_json(settings, ate, rpe)
                      : format_eval_table(settings, ate, rpe));
   if (!plot.empty()) {
-    const AtePlotFiles files = write_ate_plots(ate, plot, settings.ate.sim3 ? "Sim(3)" : "SE(3)");
+    EvalPlotOptions options;
+    options.run_name = plot_run_name(title, settings.estimate_file);
+    options.alignment_name = settings.ate.sim3 ? "Sim(3)" : "SE(3)";
+    options.rpe_delta = rpe_delta_text(settings.rpe);
+    const EvalPlotFiles files = write_eval_plots(ground_truth, estimate, ate, rpe, plot, options);
     // Keep stdout pure JSON under --json: the plot list goes to stderr.
     std::ostream& note = json ? std::cerr : std::cout;
-    note << "plots: " << files.trajectory_png.string() << " " << files.trajectory_svg.string()
-         << " " << files.error_png.string() << " " << files.error_svg.string() << "\n";
+    note << "plots:";
+    for (const auto& file : files.files) note << " " << file.string();
+    note << "\n";
   }
   return 0;
 }
@@ -82,12 +130,17 @@ Command add_eval_command(CLI::App& root) {
       ->check(CLI::IsMember({"s", "f"}))
       ->capture_default_str();
   app->add_flag("--json", *json, "print the results as JSON instead of a table");
+  auto title = std::make_shared<std::string>();
   app->add_option("--plot", *plot,
-                  "write trajectory and error plots (PNG and SVG) into this folder");
-  return {app, [settings, unit, json, plot](const GlobalOptions&) {
+                  "write plots (PNG and SVG) into this folder: trajectory top view coloured by "
+                  "ATE, ATE, position, orientation and RPE over time");
+  app->add_option("--title", *title,
+                  "run name leading every plot title (default: '<sequence>, mode <mode>' from the "
+                  "stats.json beside --est, as 'pspslam run' writes it)");
+  return {app, [settings, unit, json, plot, title](const GlobalOptions&) {
             settings->rpe.offset = settings->ate.offset;
             settings->rpe.unit = *unit == "s" ? RpeDeltaUnit::seconds : RpeDeltaUnit::frames;
-            return evaluate(*settings, *json, *plot);
+            return evaluate(*settings, *json, *plot, *title);
           }};
 }
 

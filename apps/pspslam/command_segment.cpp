@@ -16,6 +16,7 @@
 #include "pspslam/core/output_paths.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/semantic/onnx_segmenter.h"
+#include "pspslam/semantic/overlay.h"
 
 namespace pspslam::cli {
 namespace {
@@ -85,7 +86,8 @@ int segment(const SegmentFlags& flags) {
     const cv::Mat mask = dynamic_mask(labels, dynamic_ids, dilation);
     const std::string stem = chosen[i].stem().string();
     const bool ok =
-        cv::imwrite((out / (stem + "_overlay.png")).string(), overlay_labels(bgr, labels)) &&
+        cv::imwrite((out / (stem + "_overlay.png")).string(),
+                    overlay_segmentation(bgr, labels, dynamic_ids, segmenter->class_names())) &&
         cv::imwrite((out / (stem + "_labels.png")).string(), labels) &&
         cv::imwrite((out / (stem + "_mask.png")).string(), mask);
     if (!ok) throw Error("segment: cannot write images into '" + out.string() + "'");
@@ -109,7 +111,8 @@ Command add_segment_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "segment",
       "segment images with an ONNX network (overlays, masks, timing).\n"
-      "Writes <name>_overlay.png (class colours), <name>_labels.png (class ids) and "
+      "Writes <name>_overlay.png (dynamic classes in strong colours with an outline, static "
+      "classes muted, legend of the classes present), <name>_labels.png (class ids) and "
       "<name>_mask.png (255 = dynamic class) and prints the inference time.");
   auto flags = std::make_shared<SegmentFlags>();
   app->add_option("--model", flags->model, "segmenter metadata YAML")->capture_default_str();

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
 #include "pspslam/core/shared_paths.h"
@@ -32,6 +33,11 @@ Result pspslam_in(const std::filesystem::path& folder, const std::string& argume
       "cd '" + folder.string() + "' && " + std::string(PSPSLAM_CLI_PATH) + " " + arguments,
       &result.output);
   return result;
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
 }
 
 bool contains(const std::string& text, const std::string& part) {
@@ -161,10 +167,55 @@ TEST(CliEval, TableJsonAndPlots) {
   EXPECT_TRUE(contains(r.output, "\"scale\": 0.90909090909")) << r.output;
   EXPECT_EQ(report["ate"]["error_m"]["count"], 151);
   EXPECT_LT(report["ate"]["error_m"]["rmse"].get<double>(), 1e-9);
-  for (const char* name : {"trajectory_top_view.png", "trajectory_top_view.svg",
-                           "ate_over_time.png", "ate_over_time.svg"}) {
-    EXPECT_TRUE(std::filesystem::exists(dir / "plots" / name)) << name;
+  for (const char* name : {"trajectory_top_view", "ate_over_time", "position_over_time",
+                           "orientation_over_time", "rpe_over_time"}) {
+    const auto png = dir / "plots" / (std::string(name) + ".png");
+    EXPECT_FALSE(cv::imread(png.string()).empty()) << png;
+    EXPECT_TRUE(contains(r.output, png.string())) << r.output;
+    const std::string svg = read_text(dir / "plots" / (std::string(name) + ".svg"));
+    EXPECT_EQ(svg.rfind("<?xml", 0), 0u) << name;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << name;
   }
+  // No stats.json beside the estimate and no --title: titles carry no run name.
+  EXPECT_TRUE(contains(read_text(dir / "plots" / "trajectory_top_view.svg"),
+                       ">top view (x-z plane), estimate after Sim(3) alignment, coloured by "
+                       "ATE</text>"));
+}
+
+// Plot titles name the run: from the stats.json `pspslam run` writes beside its trajectories,
+// or from --title, which wins.
+TEST(CliEval, PlotTitlesNameSequenceAndMode) {
+  const auto dir = testing::make_temp_dir("cli_titles");
+  write_trajectories(dir, 1.1);
+  std::ofstream(dir / "stats.json")
+      << R"({"sequence": "/data/sets/bonn_crowd_dev/", "mode": "geometry", "frames": 151})";
+  const std::string files =
+      " --gt " + (dir / "gt.txt").string() + " --est " + (dir / "est.txt").string();
+  Result r = pspslam("eval" + files + " --plot " + (dir / "a").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(read_text(dir / "a" / "trajectory_top_view.svg"),
+                       ">bonn_crowd_dev, mode geometry: top view (x-z plane), estimate after "
+                       "SE(3) alignment, coloured by ATE</text>"));
+  EXPECT_TRUE(contains(read_text(dir / "a" / "rpe_over_time.svg"),
+                       ">bonn_crowd_dev, mode geometry: translational RPE over 1 s: RMSE "));
+  EXPECT_TRUE(contains(read_text(dir / "a" / "position_over_time.svg"), ">x [m]</text>"));
+  EXPECT_TRUE(contains(read_text(dir / "a" / "orientation_over_time.svg"), ">yaw [deg]</text>"));
+
+  r = pspslam("eval" + files + " --rpe-delta 10 --rpe-unit f --title 'fr3 walking, run 2' --plot " +
+              (dir / "b").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(read_text(dir / "b" / "ate_over_time.svg"),
+                       ">fr3 walking, run 2: ATE over time (SE(3) alignment): RMSE "));
+  EXPECT_TRUE(contains(read_text(dir / "b" / "rpe_over_time.svg"),
+                       ">fr3 walking, run 2: translational RPE over 10 frames: RMSE "));
+
+  // A stats.json that is not JSON only costs the name, with a warning.
+  std::ofstream(dir / "stats.json") << "{ not json";
+  r = pspslam("eval" + files + " --plot " + (dir / "c").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, (dir / "stats.json").string() + ": not read for the plot titles"))
+      << r.output;
+  EXPECT_TRUE(contains(read_text(dir / "c" / "trajectory_top_view.svg"), ">top view (x-z plane)"));
 }
 
 // --gt-body-to-camera moves the ground truth onto the camera. The camera turns on a circle; the

@@ -76,6 +76,8 @@ AteResult compute_ate(const Trajectory& ground_truth, const Trajectory& estimate
     AtePair& pair = result.pairs[k];
     pair.gt_timestamp = gt_times[matches[k].first];
     pair.est_timestamp = est_times[matches[k].second];
+    pair.gt_index = matches[k].first;
+    pair.est_index = matches[k].second;
     pair.gt_position = gt_xyz.col(k);
     pair.est_aligned = result.alignment.apply(est_xyz.col(k));
     pair.error = (pair.est_aligned - pair.gt_position).norm();

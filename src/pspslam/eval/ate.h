@@ -39,6 +39,9 @@ Alignment align_points(const Eigen::Matrix3Xd& model, const Eigen::Matrix3Xd& da
 struct AtePair {
   Timestamp gt_timestamp = 0.0;
   Timestamp est_timestamp = 0.0;
+  // Positions of the pair in the trajectories given to compute_ate (plots look up orientations).
+  size_t gt_index = 0;
+  size_t est_index = 0;
   Eigen::Vector3d gt_position = Eigen::Vector3d::Zero();
   Eigen::Vector3d est_aligned = Eigen::Vector3d::Zero();  // estimate after alignment
   double error = 0.0;                                     // |est_aligned - gt_position|, m

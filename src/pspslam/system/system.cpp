@@ -1,4 +1,7 @@
-// Thread layout of the SLAM system (PSPNet-SLAM, paper Fig. 1):
+// Thread layout of the SLAM system (PSPNet-SLAM, paper Fig. 1). System owns every thread object;
+// the dynamic-scene steps 1, 2, 4 and 6 below are DynamicPipeline (dynamic/dynamic_pipeline.h),
+// which System drives on the caller thread and which owns the semantic thread. Frames come from
+// the caller: `pspslam run` feeds a recorded sequence through SequenceRunner (session/).
 //
 //   semantic thread         SemanticThread (semantic/): one Segmenter (our PSPNet over ONNX);
 //     (modes semantic,        frames are announce()d ahead of process(), so the network works on
@@ -6,7 +9,8 @@
 //                             dilated dynamic-class masks by frame id
 //                                  | newest / own-frame mask
 //                                  v
-//   caller thread           System::process(), per frame, in this order:
+//   caller thread           System::process(), per frame, in this order (steps 1, 2, 4, 6:
+//                             DynamicPipeline::begin_frame / remove_dynamic / end_frame):
 //                             1. LK flow previous -> current frame and the compensated
 //                                homography H (eq. 10-11); recorded in a HomographyChain
 //                             2. semantic mask: deterministic = wait for this frame's own mask;
@@ -51,19 +55,14 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
-#include <deque>
 #include <limits>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <vector>
 
-#include "pspslam/dynamic/frame_flow.h"
-#include "pspslam/dynamic/keypoint_fusion.h"
-#include "pspslam/dynamic/map_reference_views.h"
-#include "pspslam/dynamic/mask_warper.h"
+#include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
-#include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
@@ -75,8 +74,6 @@
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
-#include "pspslam/semantic/onnx_segmenter.h"
-#include "pspslam/semantic/semantic_thread.h"
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
@@ -173,241 +170,6 @@ class System::MappingConnection final : public KeyFrameSink {
   std::uint64_t bundle_adjustments_seen_ = 0;
   double ba_ms_total_ = 0.0;
   LocalMappingStats last_;
-};
-
-// The dynamic-scene stages around tracking and their state between frames (steps 1, 2, 4, 6 of
-// the layout above). Owns the semantic thread; everything else runs on the caller's thread.
-class System::DynamicPipeline {
- public:
-  DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera, Map& map)
-      : options_(options), camera_(camera), map_(map), culler_(options.culling) {
-    GeometryParams geometry = options.geometry;
-    if (options.mode == DynamicMode::full) geometry.search.strategy = SearchStrategy::ant_colony;
-    if (options.mode == DynamicMode::exhaustive)
-      geometry.search.strategy = SearchStrategy::exhaustive;
-    if (uses_geometry(options.mode)) geometry_ = std::make_unique<GeometryStage>(camera, geometry);
-    if (uses_semantics(options.mode)) {
-      SemanticParams params = options.semantic;
-      // Deterministic mode announces one frame ahead: two may be pending and none may be
-      // dropped. Real-time mode keeps only the newest pending frame.
-      params.queue_size = options.realtime ? 1 : 2;
-      semantic_ = std::make_unique<SemanticThread>(OnnxSegmenter::from_file(options.model), params);
-    }
-  }
-
-  void announce(const RgbdFrame& frame) {
-    if (!semantic_) return;
-    const std::int64_t id = next_announced_++;
-    submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
-    while (submitted_.size() > 64) submitted_.pop_front();
-    semantic_->submit(id, frame.timestamp, frame.bgr);
-  }
-
-  // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
-  // when none is usable).
-  cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report) {
-    current_id_ = next_id_++;
-    if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
-    const auto start = std::chrono::steady_clock::now();
-    H_previous_to_current_.reset();
-    if (geometry_ || (semantic_ && options_.realtime)) {
-      flow_.track(previous_gray_, gray, previous_points_);
-      const CompensatedHomography H = estimate_compensated_homography(
-          std::span<const Eigen::Vector2d>(flow_.matched_previous()),
-          std::span<const Eigen::Vector2d>(flow_.matched_current()), options_.geometry.homography);
-      if (H.valid) H_previous_to_current_ = H.H;
-    }
-    chain_.record(current_id_, H_previous_to_current_);
-    previous_gray_ = gray;
-    report.flow_ms = milliseconds_since(start);
-    return semantic_ ? semantic_mask(report) : cv::Mat();
-  }
-
-  // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
-  void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
-                      DynamicReport& report) {
-    geometry_mask_.release();
-    const std::vector<std::uint8_t>* geometry_flags = nullptr;
-    if (geometry_ && prior_pose()) collect_reference_views();
-    if (geometry_ && prior_pose() && !views_.empty()) {
-      const auto start = std::chrono::steady_clock::now();
-      pixels_.resize(features.keypoints.size());
-      // Distorted pixel positions: the depth image is registered to the distorted image, and
-      // the lens distortion of Kinect-class presets moves pixels by less than the test's patch.
-      for (size_t i = 0; i < features.keypoints.size(); ++i)
-        pixels_[i] = {features.keypoints[i].pt.x, features.keypoints[i].pt.y};
-      GeometryFrameInput input;
-      input.depth = depth;
-      input.T_world_camera = *prior_pose();
-      input.keypoints = pixels_;
-      input.references = views_;
-      // The stage maps each keypoint back through the flow step's H into the previous mask, so
-      // the mask needs no full-image warp here.
-      if (!previous_mask_.empty() && H_previous_to_current_) {
-        input.previous_dynamic_mask = previous_mask_;
-        input.H_previous_to_current = H_previous_to_current_;
-      }
-      GeometryFrameResult result = geometry_->process(input);
-      report.geometry_ms = milliseconds_since(start);
-      report.geometry_search_ms = result.timing.search_ms;
-      report.geometry_ran = true;
-      report.tested_points = result.tested_count;
-      report.dynamic_points = result.dynamic_count;
-      geometry_flags_ = std::move(result.keypoint_dynamic);
-      geometry_flags = &geometry_flags_;
-      geometry_mask_ = std::move(result.dynamic_mask);
-    }
-    fuse_keypoint_flags(features.keypoints, semantic_mask,
-                        geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)
-                                       : std::span<const std::uint8_t>(),
-                        dynamic_flags_);
-    report.masked_keypoints =
-        remove_flagged_keypoints(dynamic_flags_, features.keypoints, features.descriptors);
-    // Static keypoints of this frame seed the next frame's optical flow.
-    previous_points_.clear();
-    for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
-  }
-
-  // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
-  // culled, and the geometry stage takes its reference views from the map's keyframes since
-  // the run inserts none. Call after the map is loaded.
-  void use_loaded_map_only() {
-    protect_map_ = true;
-    if (geometry_) map_references_.emplace(map_, camera_);
-  }
-
-  // The map was corrected under the last tracked pose (loop closing): take the corrected one.
-  void reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
-    if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
-  }
-  // The fused semantic + geometry mask of the frame end_frame() finished last.
-  const cv::Mat& fused_mask() const { return previous_mask_; }
-
-  // Step 6 and the state for the next frame.
-  void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
-                 DynamicReport& report) {
-    previous_mask_ = fuse_dynamic_masks(semantic_mask, geometry_mask_, 0);
-    if (result.keyframe_inserted && geometry_) {
-      if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
-        // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
-        references_.push_front({keyframe, depth});
-        // A pool larger than the views the test uses: the stage picks them by coverage of the
-        // frame (reference_selection.h), so a camera turn does not leave the image edge unseen.
-        const size_t keep = kReferencePoolFactor *
-                            static_cast<size_t>(options_.geometry.multiview.max_reference_views);
-        while (references_.size() > keep) references_.pop_back();
-      }
-    }
-    if (result.T_world_camera) {
-      if (last_pose_ && last_pose_id_ + 1 == current_id_) {
-        velocity_ = last_pose_->inverse() * *result.T_world_camera;  // T_last_current
-      } else {
-        velocity_.reset();
-      }
-      last_pose_ = result.T_world_camera;
-      last_pose_id_ = current_id_;
-      if (!previous_mask_.empty() && !protect_map_) {
-        const auto points = map_.reference_map_points();
-        const auto& culled =
-            culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
-        if (!culled.empty()) {
-          std::lock_guard lock(map_.update_mutex());
-          for (const auto& point : culled) map_.erase_map_point(point);
-        }
-        report.culled_map_points = static_cast<int>(culled.size());
-      }
-    }
-  }
-
- private:
-  struct Reference {
-    std::weak_ptr<KeyFrame> keyframe;  // its pose is read at use: local BA keeps refining it
-    cv::Mat depth;
-  };
-  struct Submitted {
-    std::int64_t id = 0;
-    Timestamp timestamp = 0.0;
-    std::chrono::steady_clock::time_point time;
-  };
-
-  cv::Mat semantic_mask(DynamicReport& report) {
-    std::shared_ptr<const SemanticResult> result;
-    if (!options_.realtime) {
-      const auto start = std::chrono::steady_clock::now();
-      result = semantic_->wait_for(current_id_, options_.semantic_timeout);
-      report.semantic_wait_ms = milliseconds_since(start);
-    }
-    if (!result) result = semantic_->newest();
-    if (!result || result->frame_id > current_id_) return {};
-    const WarpedMask warped =
-        warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
-    if (warped.mask.empty()) return {};
-    report.mask_age_frames = warped.age_frames;
-    report.mask_warped = warped.warped;
-    report.semantic_inference_ms = result->inference_ms;
-    for (const Submitted& submitted : submitted_) {
-      if (submitted.id == result->frame_id)
-        report.mask_latency_ms = milliseconds_since(submitted.time);
-    }
-    return warped.mask;
-  }
-
-  // The geometry stage's reference pool: the depth images of this run's newest keyframes, or in
-  // localisation the loaded map's keyframes nearest the pose prior.
-  void collect_reference_views() {
-    views_.clear();
-    const size_t pool_size =
-        kReferencePoolFactor * static_cast<size_t>(options_.geometry.multiview.max_reference_views);
-    if (map_references_) {
-      map_references_->pool(*prior_pose(), pool_size, views_);
-      return;
-    }
-    for (const auto& reference : references_) {
-      if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
-        views_.push_back({keyframe->T_world_camera(), reference.depth});
-    }
-  }
-
-  std::optional<Pose> prior_pose() const {
-    if (!last_pose_ || last_pose_id_ + 1 != current_id_) return std::nullopt;
-    // Constant velocity, as tracking's own motion model.
-    return velocity_ ? *last_pose_ * *velocity_ : *last_pose_;
-  }
-
-  // Reference pool = this many times the multi-view test's views (12-15 keyframe depths, ~1 MB
-  // each; docs/geometry.md measured the recall gain with a pool of 20 frames).
-  static constexpr size_t kReferencePoolFactor = 3;
-
-  DynamicOptions options_;
-  PinholeCamera camera_;
-  Map& map_;
-  std::unique_ptr<SemanticThread> semantic_;
-  std::unique_ptr<GeometryStage> geometry_;
-  FrameFlow flow_;
-  HomographyChain chain_;
-  DynamicPointCuller culler_;
-
-  std::int64_t next_id_ = 0;         // processed frames
-  std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
-  std::int64_t current_id_ = 0;
-  std::deque<Submitted> submitted_;
-  std::deque<Reference> references_;                 // newest keyframe first
-  std::optional<MapReferenceViews> map_references_;  // localisation only
-  bool protect_map_ = false;                         // localisation: never erase map points
-  std::optional<Eigen::Matrix3d> H_previous_to_current_;
-  cv::Mat previous_gray_;
-  cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
-  cv::Mat geometry_mask_;
-  std::optional<Pose> last_pose_;
-  std::optional<Pose> velocity_;
-  std::int64_t last_pose_id_ = -1;
-
-  // Per-frame buffers, reused.
-  std::vector<cv::Point2f> previous_points_;
-  std::vector<Eigen::Vector2d> pixels_;
-  std::vector<DepthView> views_;
-  std::vector<std::uint8_t> geometry_flags_;
-  std::vector<std::uint8_t> dynamic_flags_;
 };
 
 System::System(const SystemConfig& config, SystemOptions options)

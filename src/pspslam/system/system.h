@@ -9,14 +9,12 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
-#include "pspslam/dynamic/dynamic_mode.h"
-#include "pspslam/dynamic/dynamic_point_culler.h"
-#include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/semantic/semantic_params.h"
+#include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/tracking/tracker.h"
 
 namespace pspslam {
 
+class DynamicPipeline;
 class LocalMapping;
 class LoopClosing;
 class Map;
@@ -25,22 +23,6 @@ class PlaceRecognition;
 struct RgbdFrame;
 struct RgbdCamera;
 struct ScalePyramid;
-
-// How dynamic content is detected and removed (issue #7; `pspslam run --dynamic`).
-struct DynamicOptions {
-  DynamicMode mode = DynamicMode::off;
-  // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
-  std::filesystem::path model;
-  // true: never wait for segmentation, use the newest mask warped into the frame (live camera).
-  // false: wait for each frame's own mask (reproducible accuracy runs).
-  bool realtime = false;
-  // mask_dilation_px is the semantic margin; queue_size is set by the system from `realtime`.
-  SemanticParams semantic;
-  GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
-  DynamicCullingParams culling;
-  // Deterministic mode gives up on a frame's mask after this long (then runs without it).
-  std::chrono::milliseconds semantic_timeout{30000};
-};
 
 // Place recognition (issue #4): bag-of-words vocabulary and keyframe database.
 struct PlaceOptions {
@@ -77,23 +59,6 @@ struct SystemOptions {
   // Localisation only (`--localization`): track against the map, never insert keyframes; no
   // local mapping and no loop closing run.
   bool localization_only = false;
-};
-
-// What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
-struct DynamicReport {
-  double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
-  double semantic_wait_ms = 0.0;     // time tracking blocked waiting for the mask
-  double semantic_inference_ms = 0;  // inference time of the mask used (0: none used)
-  double geometry_ms = 0.0;          // multi-view test + search + region growing
-  double geometry_search_ms = 0.0;   // of which: the (ant-colony or exhaustive) search
-  int mask_age_frames = -1;          // current frame - the mask's frame; -1: no mask
-  double mask_latency_ms = 0.0;      // from submitting the mask's frame until its use here
-  bool mask_warped = false;
-  bool geometry_ran = false;  // false without a pose prior or reference keyframes
-  int tested_points = 0;      // multi-view tests run
-  int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
-  int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
-  int culled_map_points = 0;  // map points erased for lying on dynamic pixels
 };
 
 // One frame through the system: the tracking result and where the time went.
@@ -178,7 +143,6 @@ class System {
 
  private:
   class MappingConnection;
-  class DynamicPipeline;
 
   void wait_for_local_mapping_if_synchronous();
 

@@ -1,5 +1,6 @@
 // `pspslam run`: SLAM on an RGB-D sequence. This file only turns the flags into RunOptions; the
 // run itself (frame loop, output files, statistics) is SequenceRunner (session/), which writes
+// (per-frame masks and overlays with --save-masks / --save-overlays, session/frame_images.h)
 // into OUT/
 //   trajectory.txt   T_world_camera of every tracked frame (TUM), flushed per frame so an
 //                    interrupted run leaves a valid file
@@ -113,6 +114,8 @@ struct RunFlags {
   int cull_hits = 3;
   std::string export_map;
   std::string export_dense;
+  std::string save_masks;
+  std::string save_overlays;
 };
 
 // A path the user typed is relative to the current folder; only the built-in defaults are found
@@ -133,6 +136,8 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   options.outputs.save_map = flags.save_map;
   options.outputs.export_map = flags.export_map;
   options.outputs.export_dense = flags.export_dense;
+  options.outputs.masks = flags.save_masks;
+  options.outputs.overlays = flags.save_overlays;
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
 
@@ -250,6 +255,15 @@ Command add_run_command(CLI::App& root) {
   app->add_option("--export-dense", flags->export_dense,
                   "also write a dense PLY cloud back-projected from the keyframes' depth at their "
                   "final poses, dynamic pixels left out (1 cm voxels, every 4th pixel)");
+  app->add_option("--save-masks", flags->save_masks,
+                  "write each processed frame's final dynamic mask (semantic + geometry) into "
+                  "this folder: 8-bit PNG, 255 = dynamic, named after the colour image "
+                  "(rgb/1548339828.32144.png -> DIR/1548339828.32144.png)");
+  app->add_option("--save-overlays", flags->save_overlays,
+                  "write a picture per processed frame into this folder: the semantic overlay with "
+                  "every keypoint marked by its fate (tracked / kept unmatched / dropped by the "
+                  "semantic mask / dropped by the geometry test) and a legend; costs a second ORB "
+                  "extraction per frame");
   return {app, [flags](const GlobalOptions& global) { return run_slam(*flags, global); }};
 }
 

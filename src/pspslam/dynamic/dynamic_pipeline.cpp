@@ -23,6 +23,20 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+const char* to_string(KeypointFate fate) {
+  switch (fate) {
+    case KeypointFate::tracked:
+      return "tracked";
+    case KeypointFate::unmatched:
+      return "unmatched";
+    case KeypointFate::semantic:
+      return "semantic";
+    case KeypointFate::geometry:
+      return "geometry";
+  }
+  return "?";
+}
+
 DynamicPipeline::DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera,
                                  Map& map)
     : options_(options), camera_(camera), map_(map), culler_(options.culling) {
@@ -54,6 +68,7 @@ void DynamicPipeline::announce(const RgbdFrame& frame) {
 cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray,
                                      DynamicReport& report) {
   current_id_ = next_id_++;
+  labels_.release();
   if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
   const auto start = std::chrono::steady_clock::now();
   H_previous_to_current_.reset();
@@ -71,7 +86,8 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
 }
 
 void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask,
-                                     OrbFeatures& features, DynamicReport& report) {
+                                     OrbFeatures& features, DynamicReport& report,
+                                     std::vector<KeypointRecord>* dropped) {
   geometry_mask_.release();
   const std::vector<std::uint8_t>* geometry_flags = nullptr;
   if (geometry_ && prior_pose()) collect_reference_views();
@@ -107,6 +123,15 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semant
                       geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)
                                      : std::span<const std::uint8_t>(),
                       dynamic_flags_);
+  if (dropped) {
+    // The same precedence as fuse_keypoint_flags(): a geometry flag first, else the mask.
+    for (size_t i = 0; i < features.keypoints.size(); ++i) {
+      if (!dynamic_flags_[i]) continue;
+      const bool by_geometry = geometry_flags != nullptr && (*geometry_flags)[i] != 0;
+      dropped->push_back({features.keypoints[i].pt,
+                          by_geometry ? KeypointFate::geometry : KeypointFate::semantic});
+    }
+  }
   report.masked_keypoints =
       remove_flagged_keypoints(dynamic_flags_, features.keypoints, features.descriptors);
   // Static keypoints of this frame seed the next frame's optical flow.
@@ -173,6 +198,7 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
   report.mask_age_frames = warped.age_frames;
   report.mask_warped = warped.warped;
   report.semantic_inference_ms = result->inference_ms;
+  labels_ = result->labels;
   for (const Submitted& submitted : submitted_) {
     if (submitted.id == result->frame_id)
       report.mask_latency_ms = milliseconds_since(submitted.time);

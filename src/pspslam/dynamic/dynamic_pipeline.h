@@ -44,6 +44,20 @@ struct DynamicOptions {
   std::chrono::milliseconds semantic_timeout{30000};
 };
 
+// What became of one extracted keypoint (pictures of a run: `pspslam run --save-overlays`).
+enum class KeypointFate : std::uint8_t {
+  tracked,    // kept and matched to a map point after pose optimisation
+  unmatched,  // kept, but no map point matched it (or its match was a pose outlier)
+  semantic,   // on the semantic mask: the extractor never returns it (see DynamicPipeline)
+  geometry,   // dropped by the geometry stage (multi-view test or grown region)
+};
+const char* to_string(KeypointFate fate);
+
+struct KeypointRecord {
+  cv::Point2f position;  // distorted image coordinates, as extracted
+  KeypointFate fate = KeypointFate::unmatched;
+};
+
 // What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
 struct DynamicReport {
   double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
@@ -83,8 +97,10 @@ class DynamicPipeline {
   cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report);
 
   // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
+  // `dropped` (null unless pictures are asked for) receives each removed keypoint with the
+  // verdict that removed it.
   void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
-                      DynamicReport& report);
+                      DynamicReport& report, std::vector<KeypointRecord>* dropped = nullptr);
 
   // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
   // culled, and the geometry stage takes its reference views from the map's keyframes since
@@ -96,6 +112,10 @@ class DynamicPipeline {
 
   // The fused semantic + geometry mask of the frame end_frame() finished last.
   const cv::Mat& fused_mask() const { return previous_mask_; }
+  // Class labels (CV_8UC1) of the segmentation whose mask the last begin_frame() used; empty
+  // without one. In --realtime runs they may be of an earlier frame (the mask was warped, the
+  // labels are not). Shared with the semantic thread's result, not copied.
+  const cv::Mat& semantic_labels() const { return labels_; }
 
   // Step 6 and the state for the next frame.
   void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
@@ -140,6 +160,7 @@ class DynamicPipeline {
   cv::Mat previous_gray_;
   cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
   cv::Mat geometry_mask_;
+  cv::Mat labels_;  // of the mask used for the current frame
   std::optional<Pose> last_pose_;
   std::optional<Pose> velocity_;
   std::int64_t last_pose_id_ = -1;

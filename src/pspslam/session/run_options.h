@@ -22,6 +22,10 @@ struct RunOutputs {
   std::filesystem::path save_map;                // binary map (persistence/)
   std::filesystem::path export_map;              // static map points, PLY
   std::filesystem::path export_dense;            // dense static cloud, PLY
+  // Per-frame pictures (frame_images.h), one file per processed frame named after its colour
+  // image: the final dynamic mask (8-bit PNG, 255 = dynamic) and the keypoint overlay.
+  std::filesystem::path masks;
+  std::filesystem::path overlays;
 };
 
 // Checks every output path and creates the folders (core/output_paths.h) before any work, so a

@@ -53,6 +53,7 @@ SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
           spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr)),
       frames_(frames_to_process(setup_.sequence, options_.max_frames)),
       log_(options_.outputs.folder),
+      images_(options_.outputs.masks, options_.outputs.overlays),
       statistics_(options_.system.dynamic.mode, options_.blackout) {
   const SystemOptions& system = options_.system;
   const DynamicOptions& dynamic = system.dynamic;
@@ -65,7 +66,9 @@ SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
          << (system.localization_only ? " (localisation only)" : " (extended)") << "\n";
   }
   out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off") << "\n";
-  system_ = std::make_unique<System>(setup_.config, system);
+  // Keypoint fates cost a second extraction per frame: only for the overlays.
+  if (images_.writes_overlays()) options_.system.record_keypoint_fates = true;
+  system_ = std::make_unique<System>(setup_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(setup_.config.camera.pinhole);
 }
@@ -137,6 +140,7 @@ RunOutcome SequenceRunner::run() {
         result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
         report.dynamic.masked_keypoints, report.dynamic.tested_points,
         report.dynamic.dynamic_points);
+    write_images(i, frame, report);
     if (exporter_ && result.keyframe_inserted)
       exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
                                    system_->last_dynamic_mask());
@@ -169,6 +173,15 @@ RunOutcome SequenceRunner::run() {
     return RunOutcome::never_started;
   }
   return RunOutcome::completed;
+}
+
+void SequenceRunner::write_images(size_t index, const RgbdFrame& frame, const FrameReport& report) {
+  if (!images_.writes_masks() && !images_.writes_overlays()) return;
+  const std::filesystem::path& rgb_file = setup_.sequence.files(index).rgb_file;
+  if (images_.writes_masks())
+    images_.write_mask(rgb_file, system_->last_dynamic_mask(), frame.bgr.size());
+  if (images_.writes_overlays())
+    images_.write_overlay(rgb_file, frame.bgr, system_->last_semantic_labels(), report.keypoints);
 }
 
 void SequenceRunner::finish(double seconds) {

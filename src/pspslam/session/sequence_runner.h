@@ -7,6 +7,7 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/io/sequence_setup.h"
+#include "pspslam/session/frame_images.h"
 #include "pspslam/session/frame_log.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
@@ -38,6 +39,7 @@ class SequenceRunner {
  private:
   RgbdFrame load_frame(size_t index) const;
   void check_frame_size(size_t index, const RgbdFrame& frame) const;
+  void write_images(size_t index, const RgbdFrame& frame, const FrameReport& report);
   void finish(double seconds);
 
   RunOptions options_;
@@ -45,6 +47,7 @@ class SequenceRunner {
   SequenceSetup setup_;
   size_t frames_ = 0;  // frames to process
   FrameLog log_;
+  FrameImageWriter images_;  // --save-masks / --save-overlays
   std::unique_ptr<System> system_;
   std::optional<MapExporter> exporter_;  // with --export-map / --export-dense
   RunStatistics statistics_;

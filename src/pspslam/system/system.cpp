@@ -221,6 +221,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     tracker_->start_in_loaded_map();
   }
   synchronous_local_mapping_ = options.synchronous_local_mapping;
+  record_keypoint_fates_ = options.record_keypoint_fates;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     // The callback runs on a loop closing thread with Map::update_mutex() held, so the tracker
     // (which holds it for a whole frame) is never re-anchored in the middle of a frame.
@@ -274,7 +275,11 @@ void System::announce(const RgbdFrame& frame) {
 }
 
 FrameReport System::process(const RgbdFrame& frame) {
-  if (!dynamic_) return track(frame);
+  if (!dynamic_) {
+    FrameReport report = track(frame);
+    if (record_keypoint_fates_) record_fates_of_tracked_frame(report.keypoints);
+    return report;
+  }
   FrameReport report;
   const double cpu_start = thread_cpu_ms();
   cv::Mat gray = frame.gray;
@@ -294,7 +299,9 @@ FrameReport System::process(const RgbdFrame& frame) {
       dynamic_->reanchor_last_pose(tracker_->last_tracked_world_pose());
     }
   }
-  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic);
+  std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
+  if (fates) record_fates_before_removal(gray, semantic_mask, *fates);
+  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),
                       std::move(features.descriptors), frame.depth, camera_, pyramid_);
@@ -312,7 +319,35 @@ FrameReport System::process(const RgbdFrame& frame) {
   // result would depend on thread timing (bonn `exhaustive` varied 0.0183-0.0199 m run to run).
   wait_for_local_mapping_if_synchronous();
   dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
+  if (fates) record_fates_of_tracked_frame(*fates);
   return report;
+}
+
+// The semantic mask is the extraction mask, so the features it removes never exist as keypoints.
+// To show them, the frame is extracted once more without the mask (into a buffer of its own, so
+// the tracked features are untouched) and the keypoints on the mask are recorded.
+void System::record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
+                                         std::vector<KeypointRecord>& records) {
+  if (semantic_mask.empty()) return;
+  extractor_->extract(gray, cv::Mat(), unmasked_features_);
+  for (const cv::KeyPoint& keypoint : unmasked_features_.keypoints) {
+    const int u = std::clamp(cvRound(keypoint.pt.x), 0, semantic_mask.cols - 1);
+    const int v = std::clamp(cvRound(keypoint.pt.y), 0, semantic_mask.rows - 1);
+    if (semantic_mask.at<std::uint8_t>(v, u) != 0)
+      records.push_back({keypoint.pt, KeypointFate::semantic});
+  }
+}
+
+// The keypoints that reached tracking: matched to a map point after pose optimisation or not
+// (the tracker has already cleared the matches of pose outliers).
+void System::record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const {
+  const Frame* tracked = tracker_->last_frame();
+  if (tracked == nullptr) return;
+  const std::vector<cv::KeyPoint>& keypoints = tracked->keypoints();
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    records.push_back({keypoints[i].pt,
+                       tracked->map_points[i] ? KeypointFate::tracked : KeypointFate::unmatched});
+  }
 }
 
 void System::wait_for_local_mapping_if_synchronous() {
@@ -320,6 +355,10 @@ void System::wait_for_local_mapping_if_synchronous() {
 }
 
 cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }
+
+cv::Mat System::last_semantic_labels() const {
+  return dynamic_ ? dynamic_->semantic_labels() : cv::Mat();
+}
 
 void System::shutdown() {
   if (loop_closing_ && mapping_->local_mapping() != nullptr) {

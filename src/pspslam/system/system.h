@@ -6,6 +6,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <utility>
+#include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
@@ -59,6 +60,10 @@ struct SystemOptions {
   // Localisation only (`--localization`): track against the map, never insert keyframes; no
   // local mapping and no loop closing run.
   bool localization_only = false;
+  // Fill FrameReport::keypoints (pictures of a run, `pspslam run --save-overlays`). Off by
+  // default: it costs a second, unmasked ORB extraction per frame with a semantic mask (the
+  // keypoints the mask kept the extractor from returning) and a copy of every keypoint position.
+  bool record_keypoint_fates = false;
 };
 
 // One frame through the system: the tracking result and where the time went.
@@ -71,6 +76,9 @@ struct FrameReport {
   double extraction_cpu_ms = 0.0;
   double tracking_cpu_ms = 0.0;
   DynamicReport dynamic;
+  // Every keypoint of the frame and what became of it; empty unless
+  // SystemOptions::record_keypoint_fates.
+  std::vector<KeypointRecord> keypoints;
 };
 
 struct MappingStats {
@@ -126,6 +134,9 @@ class System {
   // process() handled last; empty with DynamicMode::off or before the first mask. Shared, not
   // copied: the next process() replaces it rather than writing into it.
   cv::Mat last_dynamic_mask() const;
+  // Class labels (CV_8UC1) of the segmentation used for the frame process() handled last; empty
+  // without semantics or a mask. Shared, not copied.
+  cv::Mat last_semantic_labels() const;
 
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
   // Returns the number of keyframes and map points written.
@@ -145,6 +156,9 @@ class System {
   class MappingConnection;
 
   void wait_for_local_mapping_if_synchronous();
+  void record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
+                                   std::vector<KeypointRecord>& records);
+  void record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const;
 
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
@@ -165,6 +179,8 @@ class System {
   std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
   bool synchronous_local_mapping_ = false;
+  bool record_keypoint_fates_ = false;
+  OrbFeatures unmasked_features_;  // record_keypoint_fates only: reused every frame
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker and map go away.
   std::unique_ptr<DynamicPipeline> dynamic_;

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
@@ -521,6 +522,86 @@ TEST(Cli, VersionQuietAndLogLevel) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.output.substr(0, r.output.find('\n')),
             "error: pspslam: unknown command 'evl' (did you mean eval?)");
+}
+
+}  // namespace
+}  // namespace pspslam
+
+namespace pspslam {
+namespace {
+
+// Lines "timestamp path" of a TUM list, comments skipped.
+std::vector<std::string> listed_files(const std::filesystem::path& list) {
+  std::vector<std::string> files;
+  std::ifstream in(list);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    files.push_back(line.substr(line.find(' ') + 1));
+  }
+  return files;
+}
+
+// --save-masks writes each processed frame's final dynamic mask, named after its colour image,
+// and it lies on the people of the synthetic ground truth; --save-overlays a picture per frame.
+TEST(CliRun, SaveMasksAndOverlaysPerProcessedFrame) {
+  const auto dir = testing::make_temp_dir("cli_masks");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 30 --bodies 2 --seed 5");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const Result r =
+      pspslam("run --sequence " + (dir / "seq").string() + " --out " + (dir / "out").string() +
+              " --dynamic full --max-frames 24 --save-masks " + (dir / "masks").string() +
+              " --save-overlays " + (dir / "pictures" / "overlays").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::vector<std::string> rgb = listed_files(dir / "seq" / "rgb.txt");
+  const std::vector<std::string> truth = listed_files(dir / "seq" / "mask.txt");
+  ASSERT_EQ(rgb.size(), 30u);
+  ASSERT_EQ(truth.size(), 30u);
+  const auto count_files = [](const std::filesystem::path& folder) {
+    return std::distance(std::filesystem::directory_iterator(folder),
+                         std::filesystem::directory_iterator());
+  };
+  EXPECT_EQ(count_files(dir / "masks"), 24);
+  EXPECT_EQ(count_files(dir / "pictures" / "overlays"), 24);
+  size_t intersection = 0, united = 0, truth_pixels = 0;
+  for (size_t i = 0; i < 24; ++i) {
+    const std::string name = std::filesystem::path(rgb[i]).stem().string() + ".png";
+    const cv::Mat mask = cv::imread((dir / "masks" / name).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(mask.empty()) << name;
+    ASSERT_EQ(mask.type(), CV_8UC1) << name;
+    ASSERT_EQ(mask.size(), cv::Size(640, 480)) << name;
+    EXPECT_EQ(cv::countNonZero(mask == 0) + cv::countNonZero(mask == 255), 640 * 480) << name;
+    const cv::Mat labels = cv::imread((dir / "seq" / truth[i]).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(labels.size(), mask.size());
+    const cv::Mat people = labels != 0;
+    intersection += static_cast<size_t>(cv::countNonZero(mask & people));
+    united += static_cast<size_t>(cv::countNonZero(mask | people));
+    truth_pixels += static_cast<size_t>(cv::countNonZero(people));
+    const cv::Mat overlay =
+        cv::imread((dir / "pictures" / "overlays" / name).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(overlay.type(), CV_8UC3) << name;
+    EXPECT_EQ(overlay.size(), cv::Size(640, 480)) << name;
+  }
+  ASSERT_GT(truth_pixels, 24u * 2000u);  // people are in view
+  const double iou = static_cast<double>(intersection) / static_cast<double>(united);
+  std::cout << "mask IoU with the ground truth over 24 frames: " << iou << "\n";
+  EXPECT_GT(iou, 0.5);
+}
+
+TEST(CliRun, SaveMasksUnderAFileIsRefusedBeforeTheRun) {
+  const auto dir = testing::make_temp_dir("cli_masks_file");
+  std::ofstream(dir / "plain") << "not a folder";
+  Result r = pspslam("run --sequence " + (dir / "absent").string() + " --out " +
+                     (dir / "out").string() + " --save-masks " + (dir / "plain" / "m").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: --save-masks '" + (dir / "plain" / "m").string() + "': '" +
+                          (dir / "plain").string() + "' is a file, not a folder\n");
+  r = pspslam("run --sequence " + (dir / "absent").string() + " --out " + (dir / "out").string() +
+              " --save-overlays " + (dir / "plain").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: --save-overlays '" + (dir / "plain").string() + "'"))
+      << r.output;
 }
 
 }  // namespace

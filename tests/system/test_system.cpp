@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -20,6 +21,7 @@
 
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/eval/ate.h"
+#include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
@@ -60,6 +62,67 @@ TEST(System, TracksAShortStaticSyntheticSequenceWithinOneCentimetre) {
   EXPECT_EQ(ate.error.count, 60u);
   EXPECT_LT(ate.error.rmse, 0.01);
   EXPECT_GE(system.keyframe_trajectory().size(), 1u);
+}
+
+// Keypoint fates are opt-in (pictures of a run) and change nothing: the same poses with and
+// without them; with them, every keypoint that reached tracking is either matched or not, the
+// matched ones are the tracker's inliers, and the geometry drops are the masked keypoints.
+TEST(System, KeypointFatesAreOptInAndAccountForEveryKeypoint) {
+  SynthOptions synth = static_room(30);
+  synth.bodies = 2;
+  const SyntheticScene scene(synth);
+  const auto run = [&](bool record, std::vector<FrameReport>& reports) {
+    SystemOptions options;
+    options.synchronous_local_mapping = true;
+    options.place.relocalization = false;
+    options.place.loop_closing = false;
+    options.dynamic.mode = DynamicMode::geometry;
+    options.record_keypoint_fates = record;
+    System system(synthetic_system_config(), options);
+    SynthFrame rendered;
+    for (size_t i = 0; i < scene.frame_count(); ++i) {
+      scene.render(i, rendered, 1);
+      RgbdFrame frame;
+      frame.index = i;
+      frame.timestamp = scene.timestamp(i);
+      frame.bgr = rendered.bgr;
+      frame.depth = rendered.depth_sensor;
+      reports.push_back(system.process(frame));
+    }
+    system.shutdown();
+  };
+  std::vector<FrameReport> plain, recorded;
+  run(false, plain);
+  run(true, recorded);
+  ASSERT_EQ(plain.size(), recorded.size());
+  int geometry_drops = 0, checked_inliers = 0;
+  for (size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_TRUE(plain[i].keypoints.empty()) << "frame " << i;
+    const TrackResult& result = recorded[i].tracking;
+    ASSERT_TRUE(result.T_world_camera && plain[i].tracking.T_world_camera) << "frame " << i;
+    EXPECT_TRUE(result.T_world_camera->isApprox(*plain[i].tracking.T_world_camera, 0.0))
+        << "frame " << i;
+    std::array<int, 4> counts{};
+    for (const KeypointRecord& keypoint : recorded[i].keypoints)
+      ++counts[static_cast<size_t>(keypoint.fate)];
+    EXPECT_EQ(counts[static_cast<size_t>(KeypointFate::tracked)] +
+                  counts[static_cast<size_t>(KeypointFate::unmatched)],
+              result.num_keypoints)
+        << "frame " << i;
+    EXPECT_EQ(counts[static_cast<size_t>(KeypointFate::geometry)],
+              recorded[i].dynamic.masked_keypoints)
+        << "frame " << i;
+    EXPECT_EQ(counts[static_cast<size_t>(KeypointFate::semantic)], 0) << "no semantic mask";
+    geometry_drops += counts[static_cast<size_t>(KeypointFate::geometry)];
+    // A keyframe adds map points to its own keypoints after the inliers were counted.
+    if (!result.keyframe_inserted && result.method != TrackingMethod::kInitialization) {
+      EXPECT_EQ(counts[static_cast<size_t>(KeypointFate::tracked)], result.num_inliers)
+          << "frame " << i;
+      ++checked_inliers;
+    }
+  }
+  EXPECT_GT(geometry_drops, 100);  // the people are found
+  EXPECT_GT(checked_inliers, 15);
 }
 
 TEST(System, ABlackFrameIsReportedLostWithoutAPoseAndTrackingResumes) {

@@ -1,4 +1,7 @@
-// Thread layout of the SLAM system (PSPNet-SLAM, paper Fig. 1):
+// Thread layout of the SLAM system (PSPNet-SLAM, paper Fig. 1). System owns every thread object;
+// the dynamic-scene steps 1, 2, 4 and 6 below are DynamicPipeline (dynamic/dynamic_pipeline.h),
+// which System drives on the caller thread and which owns the semantic thread. Frames come from
+// the caller: `pspslam run` feeds a recorded sequence through SequenceRunner (session/).
 //
 //   semantic thread         SemanticThread (semantic/): one Segmenter (our PSPNet over ONNX);
 //     (modes semantic,        frames are announce()d ahead of process(), so the network works on
@@ -6,7 +9,8 @@
 //                             dilated dynamic-class masks by frame id
 //                                  | newest / own-frame mask
 //                                  v
-//   caller thread           System::process(), per frame, in this order:
+//   caller thread           System::process(), per frame, in this order (steps 1, 2, 4, 6:
+//                             DynamicPipeline::begin_frame / remove_dynamic / end_frame):
 //                             1. LK flow previous -> current frame and the compensated
 //                                homography H (eq. 10-11); recorded in a HomographyChain
 //                             2. semantic mask: deterministic = wait for this frame's own mask;
@@ -51,19 +55,14 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
-#include <deque>
 #include <limits>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <vector>
 
-#include "pspslam/dynamic/frame_flow.h"
-#include "pspslam/dynamic/keypoint_fusion.h"
-#include "pspslam/dynamic/map_reference_views.h"
-#include "pspslam/dynamic/mask_warper.h"
+#include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
-#include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
@@ -75,8 +74,6 @@
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
-#include "pspslam/semantic/onnx_segmenter.h"
-#include "pspslam/semantic/semantic_thread.h"
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
@@ -175,241 +172,6 @@ class System::MappingConnection final : public KeyFrameSink {
   LocalMappingStats last_;
 };
 
-// The dynamic-scene stages around tracking and their state between frames (steps 1, 2, 4, 6 of
-// the layout above). Owns the semantic thread; everything else runs on the caller's thread.
-class System::DynamicPipeline {
- public:
-  DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera, Map& map)
-      : options_(options), camera_(camera), map_(map), culler_(options.culling) {
-    GeometryParams geometry = options.geometry;
-    if (options.mode == DynamicMode::full) geometry.search.strategy = SearchStrategy::ant_colony;
-    if (options.mode == DynamicMode::exhaustive)
-      geometry.search.strategy = SearchStrategy::exhaustive;
-    if (uses_geometry(options.mode)) geometry_ = std::make_unique<GeometryStage>(camera, geometry);
-    if (uses_semantics(options.mode)) {
-      SemanticParams params = options.semantic;
-      // Deterministic mode announces one frame ahead: two may be pending and none may be
-      // dropped. Real-time mode keeps only the newest pending frame.
-      params.queue_size = options.realtime ? 1 : 2;
-      semantic_ = std::make_unique<SemanticThread>(OnnxSegmenter::from_file(options.model), params);
-    }
-  }
-
-  void announce(const RgbdFrame& frame) {
-    if (!semantic_) return;
-    const std::int64_t id = next_announced_++;
-    submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
-    while (submitted_.size() > 64) submitted_.pop_front();
-    semantic_->submit(id, frame.timestamp, frame.bgr);
-  }
-
-  // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
-  // when none is usable).
-  cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report) {
-    current_id_ = next_id_++;
-    if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
-    const auto start = std::chrono::steady_clock::now();
-    H_previous_to_current_.reset();
-    if (geometry_ || (semantic_ && options_.realtime)) {
-      flow_.track(previous_gray_, gray, previous_points_);
-      const CompensatedHomography H = estimate_compensated_homography(
-          std::span<const Eigen::Vector2d>(flow_.matched_previous()),
-          std::span<const Eigen::Vector2d>(flow_.matched_current()), options_.geometry.homography);
-      if (H.valid) H_previous_to_current_ = H.H;
-    }
-    chain_.record(current_id_, H_previous_to_current_);
-    previous_gray_ = gray;
-    report.flow_ms = milliseconds_since(start);
-    return semantic_ ? semantic_mask(report) : cv::Mat();
-  }
-
-  // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
-  void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
-                      DynamicReport& report) {
-    geometry_mask_.release();
-    const std::vector<std::uint8_t>* geometry_flags = nullptr;
-    if (geometry_ && prior_pose()) collect_reference_views();
-    if (geometry_ && prior_pose() && !views_.empty()) {
-      const auto start = std::chrono::steady_clock::now();
-      pixels_.resize(features.keypoints.size());
-      // Distorted pixel positions: the depth image is registered to the distorted image, and
-      // the lens distortion of Kinect-class presets moves pixels by less than the test's patch.
-      for (size_t i = 0; i < features.keypoints.size(); ++i)
-        pixels_[i] = {features.keypoints[i].pt.x, features.keypoints[i].pt.y};
-      GeometryFrameInput input;
-      input.depth = depth;
-      input.T_world_camera = *prior_pose();
-      input.keypoints = pixels_;
-      input.references = views_;
-      // The stage maps each keypoint back through the flow step's H into the previous mask, so
-      // the mask needs no full-image warp here.
-      if (!previous_mask_.empty() && H_previous_to_current_) {
-        input.previous_dynamic_mask = previous_mask_;
-        input.H_previous_to_current = H_previous_to_current_;
-      }
-      GeometryFrameResult result = geometry_->process(input);
-      report.geometry_ms = milliseconds_since(start);
-      report.geometry_search_ms = result.timing.search_ms;
-      report.geometry_ran = true;
-      report.tested_points = result.tested_count;
-      report.dynamic_points = result.dynamic_count;
-      geometry_flags_ = std::move(result.keypoint_dynamic);
-      geometry_flags = &geometry_flags_;
-      geometry_mask_ = std::move(result.dynamic_mask);
-    }
-    fuse_keypoint_flags(features.keypoints, semantic_mask,
-                        geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)
-                                       : std::span<const std::uint8_t>(),
-                        dynamic_flags_);
-    report.masked_keypoints =
-        remove_flagged_keypoints(dynamic_flags_, features.keypoints, features.descriptors);
-    // Static keypoints of this frame seed the next frame's optical flow.
-    previous_points_.clear();
-    for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
-  }
-
-  // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
-  // culled, and the geometry stage takes its reference views from the map's keyframes since
-  // the run inserts none. Call after the map is loaded.
-  void use_loaded_map_only() {
-    protect_map_ = true;
-    if (geometry_) map_references_.emplace(map_, camera_);
-  }
-
-  // The map was corrected under the last tracked pose (loop closing): take the corrected one.
-  void reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
-    if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
-  }
-  // The fused semantic + geometry mask of the frame end_frame() finished last.
-  const cv::Mat& fused_mask() const { return previous_mask_; }
-
-  // Step 6 and the state for the next frame.
-  void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
-                 DynamicReport& report) {
-    previous_mask_ = fuse_dynamic_masks(semantic_mask, geometry_mask_, 0);
-    if (result.keyframe_inserted && geometry_) {
-      if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
-        // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
-        references_.push_front({keyframe, depth});
-        // A pool larger than the views the test uses: the stage picks them by coverage of the
-        // frame (reference_selection.h), so a camera turn does not leave the image edge unseen.
-        const size_t keep = kReferencePoolFactor *
-                            static_cast<size_t>(options_.geometry.multiview.max_reference_views);
-        while (references_.size() > keep) references_.pop_back();
-      }
-    }
-    if (result.T_world_camera) {
-      if (last_pose_ && last_pose_id_ + 1 == current_id_) {
-        velocity_ = last_pose_->inverse() * *result.T_world_camera;  // T_last_current
-      } else {
-        velocity_.reset();
-      }
-      last_pose_ = result.T_world_camera;
-      last_pose_id_ = current_id_;
-      if (!previous_mask_.empty() && !protect_map_) {
-        const auto points = map_.reference_map_points();
-        const auto& culled =
-            culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
-        if (!culled.empty()) {
-          std::lock_guard lock(map_.update_mutex());
-          for (const auto& point : culled) map_.erase_map_point(point);
-        }
-        report.culled_map_points = static_cast<int>(culled.size());
-      }
-    }
-  }
-
- private:
-  struct Reference {
-    std::weak_ptr<KeyFrame> keyframe;  // its pose is read at use: local BA keeps refining it
-    cv::Mat depth;
-  };
-  struct Submitted {
-    std::int64_t id = 0;
-    Timestamp timestamp = 0.0;
-    std::chrono::steady_clock::time_point time;
-  };
-
-  cv::Mat semantic_mask(DynamicReport& report) {
-    std::shared_ptr<const SemanticResult> result;
-    if (!options_.realtime) {
-      const auto start = std::chrono::steady_clock::now();
-      result = semantic_->wait_for(current_id_, options_.semantic_timeout);
-      report.semantic_wait_ms = milliseconds_since(start);
-    }
-    if (!result) result = semantic_->newest();
-    if (!result || result->frame_id > current_id_) return {};
-    const WarpedMask warped =
-        warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
-    if (warped.mask.empty()) return {};
-    report.mask_age_frames = warped.age_frames;
-    report.mask_warped = warped.warped;
-    report.semantic_inference_ms = result->inference_ms;
-    for (const Submitted& submitted : submitted_) {
-      if (submitted.id == result->frame_id)
-        report.mask_latency_ms = milliseconds_since(submitted.time);
-    }
-    return warped.mask;
-  }
-
-  // The geometry stage's reference pool: the depth images of this run's newest keyframes, or in
-  // localisation the loaded map's keyframes nearest the pose prior.
-  void collect_reference_views() {
-    views_.clear();
-    const size_t pool_size =
-        kReferencePoolFactor * static_cast<size_t>(options_.geometry.multiview.max_reference_views);
-    if (map_references_) {
-      map_references_->pool(*prior_pose(), pool_size, views_);
-      return;
-    }
-    for (const auto& reference : references_) {
-      if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
-        views_.push_back({keyframe->T_world_camera(), reference.depth});
-    }
-  }
-
-  std::optional<Pose> prior_pose() const {
-    if (!last_pose_ || last_pose_id_ + 1 != current_id_) return std::nullopt;
-    // Constant velocity, as tracking's own motion model.
-    return velocity_ ? *last_pose_ * *velocity_ : *last_pose_;
-  }
-
-  // Reference pool = this many times the multi-view test's views (12-15 keyframe depths, ~1 MB
-  // each; docs/geometry.md measured the recall gain with a pool of 20 frames).
-  static constexpr size_t kReferencePoolFactor = 3;
-
-  DynamicOptions options_;
-  PinholeCamera camera_;
-  Map& map_;
-  std::unique_ptr<SemanticThread> semantic_;
-  std::unique_ptr<GeometryStage> geometry_;
-  FrameFlow flow_;
-  HomographyChain chain_;
-  DynamicPointCuller culler_;
-
-  std::int64_t next_id_ = 0;         // processed frames
-  std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
-  std::int64_t current_id_ = 0;
-  std::deque<Submitted> submitted_;
-  std::deque<Reference> references_;                 // newest keyframe first
-  std::optional<MapReferenceViews> map_references_;  // localisation only
-  bool protect_map_ = false;                         // localisation: never erase map points
-  std::optional<Eigen::Matrix3d> H_previous_to_current_;
-  cv::Mat previous_gray_;
-  cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
-  cv::Mat geometry_mask_;
-  std::optional<Pose> last_pose_;
-  std::optional<Pose> velocity_;
-  std::int64_t last_pose_id_ = -1;
-
-  // Per-frame buffers, reused.
-  std::vector<cv::Point2f> previous_points_;
-  std::vector<Eigen::Vector2d> pixels_;
-  std::vector<DepthView> views_;
-  std::vector<std::uint8_t> geometry_flags_;
-  std::vector<std::uint8_t> dynamic_flags_;
-};
-
 System::System(const SystemConfig& config, SystemOptions options)
     : camera_(std::make_shared<const RgbdCamera>(
           RgbdCamera::from_config(config.camera, options.virtual_baseline))),
@@ -459,6 +221,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     tracker_->start_in_loaded_map();
   }
   synchronous_local_mapping_ = options.synchronous_local_mapping;
+  record_keypoint_fates_ = options.record_keypoint_fates;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     // The callback runs on a loop closing thread with Map::update_mutex() held, so the tracker
     // (which holds it for a whole frame) is never re-anchored in the middle of a frame.
@@ -512,7 +275,11 @@ void System::announce(const RgbdFrame& frame) {
 }
 
 FrameReport System::process(const RgbdFrame& frame) {
-  if (!dynamic_) return track(frame);
+  if (!dynamic_) {
+    FrameReport report = track(frame);
+    if (record_keypoint_fates_) record_fates_of_tracked_frame(report.keypoints);
+    return report;
+  }
   FrameReport report;
   const double cpu_start = thread_cpu_ms();
   cv::Mat gray = frame.gray;
@@ -532,7 +299,9 @@ FrameReport System::process(const RgbdFrame& frame) {
       dynamic_->reanchor_last_pose(tracker_->last_tracked_world_pose());
     }
   }
-  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic);
+  std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
+  if (fates) record_fates_before_removal(gray, semantic_mask, *fates);
+  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),
                       std::move(features.descriptors), frame.depth, camera_, pyramid_);
@@ -550,7 +319,35 @@ FrameReport System::process(const RgbdFrame& frame) {
   // result would depend on thread timing (bonn `exhaustive` varied 0.0183-0.0199 m run to run).
   wait_for_local_mapping_if_synchronous();
   dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
+  if (fates) record_fates_of_tracked_frame(*fates);
   return report;
+}
+
+// The semantic mask is the extraction mask, so the features it removes never exist as keypoints.
+// To show them, the frame is extracted once more without the mask (into a buffer of its own, so
+// the tracked features are untouched) and the keypoints on the mask are recorded.
+void System::record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
+                                         std::vector<KeypointRecord>& records) {
+  if (semantic_mask.empty()) return;
+  extractor_->extract(gray, cv::Mat(), unmasked_features_);
+  for (const cv::KeyPoint& keypoint : unmasked_features_.keypoints) {
+    const int u = std::clamp(cvRound(keypoint.pt.x), 0, semantic_mask.cols - 1);
+    const int v = std::clamp(cvRound(keypoint.pt.y), 0, semantic_mask.rows - 1);
+    if (semantic_mask.at<std::uint8_t>(v, u) != 0)
+      records.push_back({keypoint.pt, KeypointFate::semantic});
+  }
+}
+
+// The keypoints that reached tracking: matched to a map point after pose optimisation or not
+// (the tracker has already cleared the matches of pose outliers).
+void System::record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const {
+  const Frame* tracked = tracker_->last_frame();
+  if (tracked == nullptr) return;
+  const std::vector<cv::KeyPoint>& keypoints = tracked->keypoints();
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    records.push_back({keypoints[i].pt,
+                       tracked->map_points[i] ? KeypointFate::tracked : KeypointFate::unmatched});
+  }
 }
 
 void System::wait_for_local_mapping_if_synchronous() {
@@ -558,6 +355,10 @@ void System::wait_for_local_mapping_if_synchronous() {
 }
 
 cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }
+
+cv::Mat System::last_semantic_labels() const {
+  return dynamic_ ? dynamic_->semantic_labels() : cv::Mat();
+}
 
 void System::shutdown() {
   if (loop_closing_ && mapping_->local_mapping() != nullptr) {

@@ -6,17 +6,16 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <utility>
+#include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
-#include "pspslam/dynamic/dynamic_mode.h"
-#include "pspslam/dynamic/dynamic_point_culler.h"
-#include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/semantic/semantic_params.h"
+#include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/tracking/tracker.h"
 
 namespace pspslam {
 
+class DynamicPipeline;
 class LocalMapping;
 class LoopClosing;
 class Map;
@@ -25,22 +24,6 @@ class PlaceRecognition;
 struct RgbdFrame;
 struct RgbdCamera;
 struct ScalePyramid;
-
-// How dynamic content is detected and removed (issue #7; `pspslam run --dynamic`).
-struct DynamicOptions {
-  DynamicMode mode = DynamicMode::off;
-  // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
-  std::filesystem::path model;
-  // true: never wait for segmentation, use the newest mask warped into the frame (live camera).
-  // false: wait for each frame's own mask (reproducible accuracy runs).
-  bool realtime = false;
-  // mask_dilation_px is the semantic margin; queue_size is set by the system from `realtime`.
-  SemanticParams semantic;
-  GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
-  DynamicCullingParams culling;
-  // Deterministic mode gives up on a frame's mask after this long (then runs without it).
-  std::chrono::milliseconds semantic_timeout{30000};
-};
 
 // Place recognition (issue #4): bag-of-words vocabulary and keyframe database.
 struct PlaceOptions {
@@ -77,23 +60,10 @@ struct SystemOptions {
   // Localisation only (`--localization`): track against the map, never insert keyframes; no
   // local mapping and no loop closing run.
   bool localization_only = false;
-};
-
-// What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
-struct DynamicReport {
-  double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
-  double semantic_wait_ms = 0.0;     // time tracking blocked waiting for the mask
-  double semantic_inference_ms = 0;  // inference time of the mask used (0: none used)
-  double geometry_ms = 0.0;          // multi-view test + search + region growing
-  double geometry_search_ms = 0.0;   // of which: the (ant-colony or exhaustive) search
-  int mask_age_frames = -1;          // current frame - the mask's frame; -1: no mask
-  double mask_latency_ms = 0.0;      // from submitting the mask's frame until its use here
-  bool mask_warped = false;
-  bool geometry_ran = false;  // false without a pose prior or reference keyframes
-  int tested_points = 0;      // multi-view tests run
-  int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
-  int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
-  int culled_map_points = 0;  // map points erased for lying on dynamic pixels
+  // Fill FrameReport::keypoints (pictures of a run, `pspslam run --save-overlays`). Off by
+  // default: it costs a second, unmasked ORB extraction per frame with a semantic mask (the
+  // keypoints the mask kept the extractor from returning) and a copy of every keypoint position.
+  bool record_keypoint_fates = false;
 };
 
 // One frame through the system: the tracking result and where the time went.
@@ -106,6 +76,9 @@ struct FrameReport {
   double extraction_cpu_ms = 0.0;
   double tracking_cpu_ms = 0.0;
   DynamicReport dynamic;
+  // Every keypoint of the frame and what became of it; empty unless
+  // SystemOptions::record_keypoint_fates.
+  std::vector<KeypointRecord> keypoints;
 };
 
 struct MappingStats {
@@ -161,6 +134,9 @@ class System {
   // process() handled last; empty with DynamicMode::off or before the first mask. Shared, not
   // copied: the next process() replaces it rather than writing into it.
   cv::Mat last_dynamic_mask() const;
+  // Class labels (CV_8UC1) of the segmentation used for the frame process() handled last; empty
+  // without semantics or a mask. Shared, not copied.
+  cv::Mat last_semantic_labels() const;
 
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
   // Returns the number of keyframes and map points written.
@@ -178,9 +154,11 @@ class System {
 
  private:
   class MappingConnection;
-  class DynamicPipeline;
 
   void wait_for_local_mapping_if_synchronous();
+  void record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
+                                   std::vector<KeypointRecord>& records);
+  void record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const;
 
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
@@ -201,6 +179,8 @@ class System {
   std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
   bool synchronous_local_mapping_ = false;
+  bool record_keypoint_fates_ = false;
+  OrbFeatures unmasked_features_;  // record_keypoint_fates only: reused every frame
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker and map go away.
   std::unique_ptr<DynamicPipeline> dynamic_;

@@ -105,6 +105,9 @@ class Tracker {
   void on_map_corrected();
   // The latest tracked pose (T_world_camera), corrected like the tracker's own state.
   std::optional<Pose> last_tracked_world_pose() const;
+  // The frame track() handled last (its map_points: the matches kept after pose optimisation,
+  // outliers cleared); null before the first.
+  const Frame* last_frame() const { return last_frame_ ? &*last_frame_ : nullptr; }
 
   // The map was loaded from a file: the first frame is relocalised in it instead of starting a
   // new map. Call before the first track(). Throws pspslam::Error without a PlaceRecognition

@@ -1,0 +1,231 @@
+#include "pspslam/dynamic/dynamic_pipeline.h"
+
+#include <mutex>
+#include <span>
+#include <utility>
+
+#include "pspslam/dynamic/keypoint_fusion.h"
+#include "pspslam/geometry/compensated_homography.h"
+#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/map/keyframe.h"
+#include "pspslam/map/map.h"
+#include "pspslam/map/map_point.h"
+#include "pspslam/semantic/onnx_segmenter.h"
+#include "pspslam/semantic/semantic_thread.h"
+
+namespace pspslam {
+namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+const char* to_string(KeypointFate fate) {
+  switch (fate) {
+    case KeypointFate::tracked:
+      return "tracked";
+    case KeypointFate::unmatched:
+      return "unmatched";
+    case KeypointFate::semantic:
+      return "semantic";
+    case KeypointFate::geometry:
+      return "geometry";
+  }
+  return "?";
+}
+
+DynamicPipeline::DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera,
+                                 Map& map)
+    : options_(options), camera_(camera), map_(map), culler_(options.culling) {
+  GeometryParams geometry = options.geometry;
+  if (options.mode == DynamicMode::full) geometry.search.strategy = SearchStrategy::ant_colony;
+  if (options.mode == DynamicMode::exhaustive)
+    geometry.search.strategy = SearchStrategy::exhaustive;
+  if (uses_geometry(options.mode)) geometry_ = std::make_unique<GeometryStage>(camera, geometry);
+  if (uses_semantics(options.mode)) {
+    SemanticParams params = options.semantic;
+    // Deterministic mode announces one frame ahead: two may be pending and none may be
+    // dropped. Real-time mode keeps only the newest pending frame.
+    params.queue_size = options.realtime ? 1 : 2;
+    semantic_ = std::make_unique<SemanticThread>(OnnxSegmenter::from_file(options.model), params);
+  }
+}
+
+// Out of line: SemanticThread is incomplete in the header.
+DynamicPipeline::~DynamicPipeline() = default;
+
+void DynamicPipeline::announce(const RgbdFrame& frame) {
+  if (!semantic_) return;
+  const std::int64_t id = next_announced_++;
+  submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
+  while (submitted_.size() > 64) submitted_.pop_front();
+  semantic_->submit(id, frame.timestamp, frame.bgr);
+}
+
+cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray,
+                                     DynamicReport& report) {
+  current_id_ = next_id_++;
+  labels_.release();
+  if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
+  const auto start = std::chrono::steady_clock::now();
+  H_previous_to_current_.reset();
+  if (geometry_ || (semantic_ && options_.realtime)) {
+    flow_.track(previous_gray_, gray, previous_points_);
+    const CompensatedHomography H = estimate_compensated_homography(
+        std::span<const Eigen::Vector2d>(flow_.matched_previous()),
+        std::span<const Eigen::Vector2d>(flow_.matched_current()), options_.geometry.homography);
+    if (H.valid) H_previous_to_current_ = H.H;
+  }
+  chain_.record(current_id_, H_previous_to_current_);
+  previous_gray_ = gray;
+  report.flow_ms = milliseconds_since(start);
+  return semantic_ ? semantic_mask(report) : cv::Mat();
+}
+
+void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask,
+                                     OrbFeatures& features, DynamicReport& report,
+                                     std::vector<KeypointRecord>* dropped) {
+  geometry_mask_.release();
+  const std::vector<std::uint8_t>* geometry_flags = nullptr;
+  if (geometry_ && prior_pose()) collect_reference_views();
+  if (geometry_ && prior_pose() && !views_.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    pixels_.resize(features.keypoints.size());
+    // Distorted pixel positions: the depth image is registered to the distorted image, and
+    // the lens distortion of Kinect-class presets moves pixels by less than the test's patch.
+    for (size_t i = 0; i < features.keypoints.size(); ++i)
+      pixels_[i] = {features.keypoints[i].pt.x, features.keypoints[i].pt.y};
+    GeometryFrameInput input;
+    input.depth = depth;
+    input.T_world_camera = *prior_pose();
+    input.keypoints = pixels_;
+    input.references = views_;
+    // The stage maps each keypoint back through the flow step's H into the previous mask, so
+    // the mask needs no full-image warp here.
+    if (!previous_mask_.empty() && H_previous_to_current_) {
+      input.previous_dynamic_mask = previous_mask_;
+      input.H_previous_to_current = H_previous_to_current_;
+    }
+    GeometryFrameResult result = geometry_->process(input);
+    report.geometry_ms = milliseconds_since(start);
+    report.geometry_search_ms = result.timing.search_ms;
+    report.geometry_ran = true;
+    report.tested_points = result.tested_count;
+    report.dynamic_points = result.dynamic_count;
+    geometry_flags_ = std::move(result.keypoint_dynamic);
+    geometry_flags = &geometry_flags_;
+    geometry_mask_ = std::move(result.dynamic_mask);
+  }
+  fuse_keypoint_flags(features.keypoints, semantic_mask,
+                      geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)
+                                     : std::span<const std::uint8_t>(),
+                      dynamic_flags_);
+  if (dropped) {
+    // The same precedence as fuse_keypoint_flags(): a geometry flag first, else the mask.
+    for (size_t i = 0; i < features.keypoints.size(); ++i) {
+      if (!dynamic_flags_[i]) continue;
+      const bool by_geometry = geometry_flags != nullptr && (*geometry_flags)[i] != 0;
+      dropped->push_back({features.keypoints[i].pt,
+                          by_geometry ? KeypointFate::geometry : KeypointFate::semantic});
+    }
+  }
+  report.masked_keypoints =
+      remove_flagged_keypoints(dynamic_flags_, features.keypoints, features.descriptors);
+  // Static keypoints of this frame seed the next frame's optical flow.
+  previous_points_.clear();
+  for (const cv::KeyPoint& keypoint : features.keypoints) previous_points_.push_back(keypoint.pt);
+}
+
+void DynamicPipeline::use_loaded_map_only() {
+  protect_map_ = true;
+  if (geometry_) map_references_.emplace(map_, camera_);
+}
+
+void DynamicPipeline::reanchor_last_pose(const std::optional<Pose>& T_world_camera) {
+  if (last_pose_ && T_world_camera) last_pose_ = T_world_camera;
+}
+
+void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
+                                const cv::Mat& semantic_mask, DynamicReport& report) {
+  previous_mask_ = fuse_dynamic_masks(semantic_mask, geometry_mask_, 0);
+  if (result.keyframe_inserted && geometry_) {
+    if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
+      // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
+      references_.push_front({keyframe, depth});
+      // A pool larger than the views the test uses: the stage picks them by coverage of the
+      // frame (reference_selection.h), so a camera turn does not leave the image edge unseen.
+      const size_t keep = kReferencePoolFactor *
+                          static_cast<size_t>(options_.geometry.multiview.max_reference_views);
+      while (references_.size() > keep) references_.pop_back();
+    }
+  }
+  if (result.T_world_camera) {
+    if (last_pose_ && last_pose_id_ + 1 == current_id_) {
+      velocity_ = last_pose_->inverse() * *result.T_world_camera;  // T_last_current
+    } else {
+      velocity_.reset();
+    }
+    last_pose_ = result.T_world_camera;
+    last_pose_id_ = current_id_;
+    if (!previous_mask_.empty() && !protect_map_) {
+      const auto points = map_.reference_map_points();
+      const auto& culled =
+          culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
+      if (!culled.empty()) {
+        std::lock_guard lock(map_.update_mutex());
+        for (const auto& point : culled) map_.erase_map_point(point);
+      }
+      report.culled_map_points = static_cast<int>(culled.size());
+    }
+  }
+}
+
+cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
+  std::shared_ptr<const SemanticResult> result;
+  if (!options_.realtime) {
+    const auto start = std::chrono::steady_clock::now();
+    result = semantic_->wait_for(current_id_, options_.semantic_timeout);
+    report.semantic_wait_ms = milliseconds_since(start);
+  }
+  if (!result) result = semantic_->newest();
+  if (!result || result->frame_id > current_id_) return {};
+  const WarpedMask warped =
+      warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
+  if (warped.mask.empty()) return {};
+  report.mask_age_frames = warped.age_frames;
+  report.mask_warped = warped.warped;
+  report.semantic_inference_ms = result->inference_ms;
+  labels_ = result->labels;
+  for (const Submitted& submitted : submitted_) {
+    if (submitted.id == result->frame_id)
+      report.mask_latency_ms = milliseconds_since(submitted.time);
+  }
+  return warped.mask;
+}
+
+// The geometry stage's reference pool: the depth images of this run's newest keyframes, or in
+// localisation the loaded map's keyframes nearest the pose prior.
+void DynamicPipeline::collect_reference_views() {
+  views_.clear();
+  const size_t pool_size =
+      kReferencePoolFactor * static_cast<size_t>(options_.geometry.multiview.max_reference_views);
+  if (map_references_) {
+    map_references_->pool(*prior_pose(), pool_size, views_);
+    return;
+  }
+  for (const auto& reference : references_) {
+    if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
+      views_.push_back({keyframe->T_world_camera(), reference.depth});
+  }
+}
+
+std::optional<Pose> DynamicPipeline::prior_pose() const {
+  if (!last_pose_ || last_pose_id_ + 1 != current_id_) return std::nullopt;
+  // Constant velocity, as tracking's own motion model.
+  return velocity_ ? *last_pose_ * *velocity_ : *last_pose_;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,176 @@
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/core/types.h"
+#include "pspslam/dynamic/dynamic_mode.h"
+#include "pspslam/dynamic/dynamic_point_culler.h"
+#include "pspslam/dynamic/frame_flow.h"
+#include "pspslam/dynamic/map_reference_views.h"
+#include "pspslam/dynamic/mask_warper.h"
+#include "pspslam/feature/orb_extractor.h"
+#include "pspslam/geometry/geometry_stage.h"
+#include "pspslam/semantic/semantic_params.h"
+#include "pspslam/tracking/tracker.h"
+
+namespace pspslam {
+
+class KeyFrame;
+class Map;
+class SemanticThread;
+struct RgbdFrame;
+
+// How dynamic content is detected and removed (issue #7; `pspslam run --dynamic`).
+struct DynamicOptions {
+  DynamicMode mode = DynamicMode::off;
+  // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
+  std::filesystem::path model;
+  // true: never wait for segmentation, use the newest mask warped into the frame (live camera).
+  // false: wait for each frame's own mask (reproducible accuracy runs).
+  bool realtime = false;
+  // mask_dilation_px is the semantic margin; queue_size is set by the pipeline from `realtime`.
+  SemanticParams semantic;
+  GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
+  DynamicCullingParams culling;
+  // Deterministic mode gives up on a frame's mask after this long (then runs without it).
+  std::chrono::milliseconds semantic_timeout{30000};
+};
+
+// What became of one extracted keypoint (pictures of a run: `pspslam run --save-overlays`).
+enum class KeypointFate : std::uint8_t {
+  tracked,    // kept and matched to a map point after pose optimisation
+  unmatched,  // kept, but no map point matched it (or its match was a pose outlier)
+  semantic,   // on the semantic mask: the extractor never returns it (see DynamicPipeline)
+  geometry,   // dropped by the geometry stage (multi-view test or grown region)
+};
+const char* to_string(KeypointFate fate);
+
+struct KeypointRecord {
+  cv::Point2f position;  // distorted image coordinates, as extracted
+  KeypointFate fate = KeypointFate::unmatched;
+};
+
+// What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
+struct DynamicReport {
+  double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
+  double semantic_wait_ms = 0.0;     // time tracking blocked waiting for the mask
+  double semantic_inference_ms = 0;  // inference time of the mask used (0: none used)
+  double geometry_ms = 0.0;          // multi-view test + search + region growing
+  double geometry_search_ms = 0.0;   // of which: the (ant-colony or exhaustive) search
+  int mask_age_frames = -1;          // current frame - the mask's frame; -1: no mask
+  double mask_latency_ms = 0.0;      // from submitting the mask's frame until its use here
+  bool mask_warped = false;
+  bool geometry_ran = false;  // false without a pose prior or reference keyframes
+  int tested_points = 0;      // multi-view tests run
+  int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
+  int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
+  int culled_map_points = 0;  // map points erased for lying on dynamic pixels
+};
+
+// The dynamic-scene stages around tracking (paper Fig. 1) and their state between frames:
+// steps 1, 2, 4 and 6 of the thread layout in system/system.cpp. Owns the semantic thread;
+// everything else runs on the caller's thread. System drives it per frame:
+//   begin_frame -> (ORB extraction with the returned mask) -> remove_dynamic -> (tracking)
+//   -> end_frame.
+class DynamicPipeline {
+ public:
+  // `map` must outlive the pipeline. Loads the segmentation model for the semantic modes
+  // (throws pspslam::Error naming the file when it cannot).
+  DynamicPipeline(const DynamicOptions& options, const PinholeCamera& camera, Map& map);
+  ~DynamicPipeline();
+  DynamicPipeline(const DynamicPipeline&) = delete;
+  DynamicPipeline& operator=(const DynamicPipeline&) = delete;
+
+  // Hands a frame to the semantic thread ahead of begin_frame (see System::announce).
+  void announce(const RgbdFrame& frame);
+
+  // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
+  // when none is usable).
+  cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report);
+
+  // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
+  // `dropped` (null unless pictures are asked for) receives each removed keypoint with the
+  // verdict that removed it.
+  void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
+                      DynamicReport& report, std::vector<KeypointRecord>* dropped = nullptr);
+
+  // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
+  // culled, and the geometry stage takes its reference views from the map's keyframes since
+  // the run inserts none. Call after the map is loaded.
+  void use_loaded_map_only();
+
+  // The map was corrected under the last tracked pose (loop closing): take the corrected one.
+  void reanchor_last_pose(const std::optional<Pose>& T_world_camera);
+
+  // The fused semantic + geometry mask of the frame end_frame() finished last.
+  const cv::Mat& fused_mask() const { return previous_mask_; }
+  // Class labels (CV_8UC1) of the segmentation whose mask the last begin_frame() used; empty
+  // without one. In --realtime runs they may be of an earlier frame (the mask was warped, the
+  // labels are not). Shared with the semantic thread's result, not copied.
+  const cv::Mat& semantic_labels() const { return labels_; }
+
+  // Step 6 and the state for the next frame.
+  void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
+                 DynamicReport& report);
+
+ private:
+  struct Reference {
+    std::weak_ptr<KeyFrame> keyframe;  // its pose is read at use: local BA keeps refining it
+    cv::Mat depth;
+  };
+  struct Submitted {
+    std::int64_t id = 0;
+    Timestamp timestamp = 0.0;
+    std::chrono::steady_clock::time_point time;
+  };
+
+  cv::Mat semantic_mask(DynamicReport& report);
+  void collect_reference_views();
+  std::optional<Pose> prior_pose() const;
+
+  // Reference pool = this many times the multi-view test's views (12-15 keyframe depths, ~1 MB
+  // each; docs/geometry.md measured the recall gain with a pool of 20 frames).
+  static constexpr size_t kReferencePoolFactor = 3;
+
+  DynamicOptions options_;
+  PinholeCamera camera_;
+  Map& map_;
+  std::unique_ptr<SemanticThread> semantic_;
+  std::unique_ptr<GeometryStage> geometry_;
+  FrameFlow flow_;
+  HomographyChain chain_;
+  DynamicPointCuller culler_;
+
+  std::int64_t next_id_ = 0;         // processed frames
+  std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
+  std::int64_t current_id_ = 0;
+  std::deque<Submitted> submitted_;
+  std::deque<Reference> references_;                 // newest keyframe first
+  std::optional<MapReferenceViews> map_references_;  // localisation only
+  bool protect_map_ = false;                         // localisation: never erase map points
+  std::optional<Eigen::Matrix3d> H_previous_to_current_;
+  cv::Mat previous_gray_;
+  cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
+  cv::Mat geometry_mask_;
+  cv::Mat labels_;  // of the mask used for the current frame
+  std::optional<Pose> last_pose_;
+  std::optional<Pose> velocity_;
+  std::int64_t last_pose_id_ = -1;
+
+  // Per-frame buffers, reused.
+  std::vector<cv::Point2f> previous_points_;
+  std::vector<Eigen::Vector2d> pixels_;
+  std::vector<DepthView> views_;
+  std::vector<std::uint8_t> geometry_flags_;
+  std::vector<std::uint8_t> dynamic_flags_;
+};
+
+}  // namespace pspslam

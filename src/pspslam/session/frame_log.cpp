@@ -1,0 +1,49 @@
+#include "pspslam/session/frame_log.h"
+
+#include <cstdio>
+
+#include "pspslam/core/error.h"
+
+namespace pspslam {
+
+std::ofstream open_output(const std::filesystem::path& file) {
+  std::ofstream stream(file);
+  if (!stream) throw Error(file.string() + ": cannot write output file");
+  return stream;
+}
+
+FrameLog::FrameLog(const std::filesystem::path& folder)
+    : trajectory_(folder / "trajectory.txt"),
+      lost_(open_output(folder / "lost_frames.txt")),
+      timing_(open_output(folder / "timing.csv")) {
+  lost_ << "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
+  timing_ << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
+             "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_"
+             "ms,mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points\n";
+}
+
+void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& report,
+                     double local_ba_ms, const MappingStats& mapping) {
+  const TrackResult& result = report.tracking;
+  if (result.T_world_camera) {
+    trajectory_.write(timestamp, *result.T_world_camera);
+  } else {
+    char line[96];
+    std::snprintf(line, sizeof(line), "%zu %.6f %s\n", index, timestamp, to_string(result.state));
+    lost_ << line << std::flush;
+  }
+  const DynamicReport& dyn = report.dynamic;
+  char row[384];
+  std::snprintf(row, sizeof(row),
+                "%zu,%.6f,%s,%s,%d,%d,%d,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%d,%d,%d,"
+                "%d\n",
+                index, timestamp, to_string(result.state), to_string(result.method),
+                result.num_keypoints, result.num_inliers, result.keyframe_inserted ? 1 : 0,
+                report.extraction_ms, report.tracking_ms, local_ba_ms, mapping.queued_keyframes,
+                report.extraction_cpu_ms, report.tracking_cpu_ms, dyn.flow_ms, dyn.semantic_wait_ms,
+                dyn.mask_age_frames, dyn.geometry_ms, dyn.tested_points, dyn.dynamic_points,
+                dyn.masked_keypoints, dyn.culled_map_points);
+  timing_ << row;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+
+#include "pspslam/core/types.h"
+#include "pspslam/io/trajectory_io.h"
+#include "pspslam/system/system.h"
+
+namespace pspslam {
+
+// The per-frame files of a run, written (and flushed) as frames come, so an interrupted run
+// leaves valid files:
+//   trajectory.txt   T_world_camera of every tracked frame (TUM)
+//   lost_frames.txt  frames without a pose (not initialised yet or lost): index timestamp state
+//   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
+//                    dynamic-scene stages (mask age, geometry time, masked keypoints)
+class FrameLog {
+ public:
+  // Creates the three files in `folder` (which must exist); throws pspslam::Error naming a file
+  // that cannot be written.
+  explicit FrameLog(const std::filesystem::path& folder);
+
+  // `local_ba_ms`: local BA time finished since the previous frame; `mapping` as of now.
+  void write(size_t index, Timestamp timestamp, const FrameReport& report, double local_ba_ms,
+             const MappingStats& mapping);
+
+  size_t poses() const { return trajectory_.count(); }
+  const std::filesystem::path& trajectory_path() const { return trajectory_.path(); }
+
+ private:
+  TrajectoryWriter trajectory_;
+  std::ofstream lost_;
+  std::ofstream timing_;
+};
+
+// Opens `file` for writing; throws pspslam::Error naming it when it cannot.
+std::ofstream open_output(const std::filesystem::path& file);
+
+}  // namespace pspslam

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+
+#include "pspslam/system/system.h"
+
+namespace pspslam {
+
+// Frames first .. first + count - 1 of a run (`pspslam run --blackout FROM:COUNT`).
+struct FrameRange {
+  size_t first = 0;
+  size_t count = 0;
+  size_t end() const { return first + count; }
+  bool covers(size_t index) const { return index >= first && index < end(); }
+};
+
+// Where a run writes. Empty paths are not written.
+struct RunOutputs {
+  std::filesystem::path folder = "pspslam_out";  // trajectory.txt, timing.csv, stats.json, ...
+  std::filesystem::path save_map;                // binary map (persistence/)
+  std::filesystem::path export_map;              // static map points, PLY
+  std::filesystem::path export_dense;            // dense static cloud, PLY
+  // Per-frame pictures (frame_images.h), one file per processed frame named after its colour
+  // image: the final dynamic mask (8-bit PNG, 255 = dynamic) and the keypoint overlay.
+  std::filesystem::path masks;
+  std::filesystem::path overlays;
+};
+
+// Checks every output path and creates the folders (core/output_paths.h) before any work, so a
+// run never computes for minutes and then fails to write. Errors name the CLI flag of the path.
+void prepare_run_outputs(const RunOutputs& outputs);
+
+// One run of the system over a recorded sequence (`pspslam run`).
+struct RunOptions {
+  std::filesystem::path sequence;
+  // Config YAML; none: SEQUENCE/config.yaml (io/sequence_setup.h).
+  std::optional<std::filesystem::path> config;
+  size_t max_frames = 0;  // 0 = all
+  // Frames fed as black images without depth: tracking is really lost (relocalisation tests).
+  std::optional<FrameRange> blackout;
+  RunOutputs outputs;
+  SystemOptions system;
+  bool progress = true;  // progress bar on stderr
+};
+
+// How a run ended (the CLI maps it to an exit status).
+enum class RunOutcome {
+  completed,
+  interrupted,    // Ctrl-C / SIGTERM: the outputs hold every frame processed so far
+  never_started,  // the whole sequence ran and no frame ever started a map
+};
+
+}  // namespace pspslam

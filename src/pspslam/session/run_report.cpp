@@ -1,0 +1,211 @@
+#include "pspslam/session/run_report.h"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "pspslam/core/error.h"
+#include "pspslam/eval/ate.h"
+#include "pspslam/eval/stats.h"
+#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/session/frame_log.h"
+
+namespace pspslam {
+namespace {
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+void print_loop_stats(const MappingStats& mapping, std::ostream& out) {
+  char line[512];
+  std::snprintf(
+      line, sizeof(line),
+      "loops:        %zu closed (last moved its keyframe %.3f m), %zu candidates rejected by "
+      "geometry; global BA %zu applied, %zu aborted (last %.2f s)\n",
+      mapping.loops_closed, mapping.last_loop_correction_m, mapping.loop_candidates_rejected,
+      mapping.global_ba_applied, mapping.global_ba_aborted, mapping.last_global_ba_seconds);
+  out << line;
+}
+
+// Blackout: how soon a pose came back, and how good the poses after the return are (errors of
+// the whole run's alignment, restricted to frames from the return on). A stats.json member.
+nlohmann::ordered_json report_blackout(const RunReportInput& input, const FrameRange& blackout,
+                                       const std::optional<AteResult>& ate_tracked,
+                                       std::ostream& out) {
+  const RunStatistics& stats = input.statistics;
+  char line[512];
+  std::snprintf(line, sizeof(line), "blackout:     frames %zu-%zu black, %zu relocalisations; ",
+                blackout.first, blackout.end() - 1, stats.relocalisations());
+  out << line;
+  const std::optional<size_t> first_pose = stats.first_pose_after_blackout();
+  if (first_pose) {
+    std::snprintf(line, sizeof(line), "first pose after the return at frame %zu (+%zu) by %s\n",
+                  *first_pose, *first_pose - blackout.end(),
+                  stats.first_method_after_blackout().c_str());
+    out << line;
+  } else {
+    out << "no pose after the return\n";
+  }
+  std::optional<ErrorStats> after_return;
+  if (ate_tracked && blackout.end() < input.frames) {
+    const Timestamp returned = input.sequence.timestamp(blackout.end());
+    std::vector<double> errors;
+    for (const AtePair& pair : ate_tracked->pairs) {
+      if (pair.est_timestamp >= returned) errors.push_back(pair.error);
+    }
+    if (!errors.empty()) {
+      after_return = compute_error_stats(errors);
+      std::snprintf(line, sizeof(line),
+                    "              after the return: %zu poses, error RMSE %.4f m, max %.4f m\n",
+                    after_return->count, after_return->rmse, after_return->max);
+      out << line;
+    }
+  }
+  return {
+      {"first", blackout.first},
+      {"count", blackout.count},
+      {"frames_to_first_pose", first_pose ? static_cast<long>(*first_pose - blackout.end()) : -1L},
+      {"after_return_rmse_m", after_return ? after_return->rmse : -1.0},
+      {"after_return_max_m", after_return ? after_return->max : -1.0}};
+}
+
+}  // namespace
+
+void write_run_report(const RunReportInput& input, std::ostream& out) {
+  const RunStatistics& stats = input.statistics;
+  const MappingStats& mapping = input.mapping;
+  const SystemOptions& system = input.options.system;
+  const std::filesystem::path& out_dir = input.options.outputs.folder;
+  const size_t processed = stats.processed();
+  const size_t lost_count = stats.lost();
+  const double seconds = input.seconds;
+
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "frames:       %zu processed, %zu tracked, %zu without pose (lost_frames.txt)\n"
+                "speed:        %.1f fps overall (%.1f s)\n"
+                "median ms:    extraction %.2f, tracking %.2f (tracking thread CPU %.2f)\n"
+                "map:          %zu keyframes, %zu map points; mapping queue max %zu, local BA "
+                "%.0f ms total\n",
+                processed, processed - lost_count, lost_count,
+                seconds > 0 ? processed / seconds : 0.0, seconds, median(stats.extraction_ms),
+                median(stats.tracking_ms), median(stats.tracking_cpu_ms), mapping.keyframes_in_map,
+                mapping.map_points, mapping.max_queued_keyframes, mapping.local_ba_ms_total);
+  out << line;
+  std::snprintf(line, sizeof(line),
+                "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
+                "%zu fused, %zu culled, %zu BA outlier observations removed\n",
+                mapping.processed_keyframes, mapping.keyframes_culled, mapping.points_triangulated,
+                mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed);
+  out << line;
+  if (system.place.loop_closing) print_loop_stats(mapping, out);
+  out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
+      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
+  std::optional<AteResult> ate_tracked;
+  std::optional<AteResult> ate_refined;
+  if (input.sequence.ground_truth() && input.estimate.size() >= 3) {
+    const std::tuple<const char*, const Trajectory*, std::optional<AteResult>*> evaluated[] = {
+        {"trajectory.txt        ", &input.estimate, &ate_tracked},
+        {"trajectory_refined.txt", &input.refined, &ate_refined}};
+    for (const auto& [name, poses, slot] : evaluated) {
+      try {
+        const AteResult ate = compute_ate(*input.sequence.ground_truth(), *poses);
+        std::snprintf(line, sizeof(line),
+                      "ATE %s (SE(3) aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
+                      "%.4f m, max %.4f m\n",
+                      name, ate.error.count, ate.error.rmse, ate.error.mean, ate.error.median,
+                      ate.error.max);
+        out << line;
+        *slot = ate;
+      } catch (const Error& e) {
+        out << "ATE " << name << ": not computed: " << e.what() << "\n";
+      }
+    }
+  }
+  nlohmann::ordered_json blackout_json;  // a stats.json member, null without a blackout
+  if (input.options.blackout)
+    blackout_json = report_blackout(input, *input.options.blackout, ate_tracked, out);
+
+  // Per-module timing and the dynamic-feature totals, printed and written to stats.json.
+  const TimingSummary t_extraction = summarize(stats.extraction_ms);
+  const TimingSummary t_semantic = summarize(stats.semantic_ms);
+  const TimingSummary t_semantic_wait = summarize(stats.semantic_wait_ms);
+  const TimingSummary t_geometry = summarize(stats.geometry_ms);
+  const TimingSummary t_search = summarize(stats.geometry_search_ms);
+  const TimingSummary t_flow = summarize(stats.flow_ms);
+  const TimingSummary t_tracking = summarize(stats.tracking_ms);
+  const TimingSummary t_mapping = summarize(stats.local_mapping_ms);
+  const TimingSummary mask_age = summarize(stats.mask_age_frames);
+  const TimingSummary mask_latency = summarize(stats.mask_latency_ms);
+  std::snprintf(line, sizeof(line),
+                "timing ms:    median/mean/p95  extraction %.1f/%.1f/%.1f  semantic inference "
+                "%.1f/%.1f/%.1f (waited %.1f/%.1f/%.1f)\n"
+                "              geometry %.1f/%.1f/%.1f (search %.1f)  flow+H %.1f  tracking "
+                "%.1f/%.1f/%.1f  local BA %.1f/%.1f/%.1f\n",
+                t_extraction.median, t_extraction.mean, t_extraction.p95, t_semantic.median,
+                t_semantic.mean, t_semantic.p95, t_semantic_wait.median, t_semantic_wait.mean,
+                t_semantic_wait.p95, t_geometry.median, t_geometry.mean, t_geometry.p95,
+                t_search.median, t_flow.median, t_tracking.median, t_tracking.mean, t_tracking.p95,
+                t_mapping.median, t_mapping.mean, t_mapping.p95);
+  out << line;
+  std::snprintf(line, sizeof(line),
+                "dynamic:      mode %s; %zu keypoints tested, %zu flagged by geometry, %zu "
+                "dropped before tracking, %zu map points culled; mask age median %.0f frames "
+                "(%.0f ms), %zu frames without mask, %zu frames dropped by the real-time feed\n",
+                to_string(system.dynamic.mode), stats.tested_points, stats.dynamic_points,
+                stats.masked_keypoints, stats.culled_points, mask_age.median, mask_latency.median,
+                stats.frames_without_mask, stats.realtime_dropped());
+  out << line;
+
+  const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
+  nlohmann::ordered_json json = {{"sequence", input.sequence.directory().string()},
+                                 {"mode", to_string(system.dynamic.mode)},
+                                 {"realtime", system.dynamic.realtime},
+                                 {"interrupted", input.interrupted},
+                                 {"frames", processed},
+                                 {"lost_frames", lost_count},
+                                 {"relocalisations", stats.relocalisations()}};
+  if (!blackout_json.is_null()) json["blackout"] = blackout_json;
+  json["realtime_dropped_frames"] = stats.realtime_dropped();
+  json["seconds"] = seconds;
+  json["fps"] = fps;
+  json["timing_ms"] = {
+      {"extraction", to_json(t_extraction)},       {"semantic", to_json(t_semantic)},
+      {"semantic_wait", to_json(t_semantic_wait)}, {"geometry", to_json(t_geometry)},
+      {"geometry_search", to_json(t_search)},      {"flow_homography", to_json(t_flow)},
+      {"tracking", to_json(t_tracking)},           {"local_mapping", to_json(t_mapping)}};
+  json["dynamic"] = {{"tested_points", stats.tested_points},
+                     {"dynamic_points", stats.dynamic_points},
+                     {"masked_keypoints", stats.masked_keypoints},
+                     {"culled_map_points", stats.culled_points},
+                     {"frames_without_mask", stats.frames_without_mask}};
+  json["mask_latency"] = {{"frames", to_json(mask_age)}, {"ms", to_json(mask_latency)}};
+  json["map"] = {{"keyframes", mapping.keyframes_in_map}, {"map_points", mapping.map_points}};
+  json["loops"] = {{"enabled", system.place.loop_closing},
+                   {"closed", mapping.loops_closed},
+                   {"global_ba_applied", mapping.global_ba_applied}};
+  const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
+      {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
+  for (const auto& [key, ate] : ates) {
+    if (!*ate) continue;
+    json[key] = {{"rmse", (*ate)->error.rmse},
+                 {"mean", (*ate)->error.mean},
+                 {"median", (*ate)->error.median},
+                 {"max", (*ate)->error.max},
+                 {"poses", (*ate)->error.count}};
+  }
+  std::ofstream file = open_output(out_dir / "stats.json");
+  // Paths are not always UTF-8 (a Latin-1 folder name); replace invalid bytes instead of
+  // throwing, so the summary is always written.
+  file << json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  out << "stats:        " << (out_dir / "stats.json").string() << "\n";
+}
+
+}  // namespace pspslam

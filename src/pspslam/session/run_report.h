@@ -1,0 +1,33 @@
+#pragma once
+
+#include <cstddef>
+#include <ostream>
+
+#include "pspslam/core/types.h"
+#include "pspslam/session/run_options.h"
+#include "pspslam/session/run_statistics.h"
+#include "pspslam/system/system.h"
+
+namespace pspslam {
+
+class RgbdSequence;
+
+// What the end of a run knows.
+struct RunReportInput {
+  const RunOptions& options;
+  const RunStatistics& statistics;
+  const MappingStats& mapping;
+  const RgbdSequence& sequence;
+  const Trajectory& estimate;  // the poses of trajectory.txt
+  const Trajectory& refined;   // trajectory_refined.txt
+  size_t frames = 0;           // frames the run was to process
+  double seconds = 0.0;
+  bool interrupted = false;
+};
+
+// The run's summary: printed to `out` (frames, speed, map, loops, ATE against the sequence's
+// ground truth, blackout recovery, per-module timing, dynamic-feature totals) and written to
+// OUT/stats.json, also for an interrupted run.
+void write_run_report(const RunReportInput& input, std::ostream& out);
+
+}  // namespace pspslam

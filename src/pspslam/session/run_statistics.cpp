@@ -1,0 +1,68 @@
+#include "pspslam/session/run_statistics.h"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+namespace pspslam {
+
+TimingSummary summarize(std::vector<double> values) {
+  TimingSummary summary;
+  summary.count = values.size();
+  if (values.empty()) return summary;
+  std::sort(values.begin(), values.end());
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  summary.mean = sum / static_cast<double>(values.size());
+  summary.median = values[values.size() / 2];
+  summary.p95 = values[std::min(values.size() - 1,
+                                static_cast<size_t>(0.95 * static_cast<double>(values.size())))];
+  return summary;
+}
+
+nlohmann::ordered_json to_json(const TimingSummary& timing) {
+  return {{"median", timing.median},
+          {"mean", timing.mean},
+          {"p95", timing.p95},
+          {"count", timing.count}};
+}
+
+void RunStatistics::add_frame(size_t index, const FrameReport& report, double local_ba_ms) {
+  const TrackResult& result = report.tracking;
+  if (result.method == TrackingMethod::kRelocalisation) ++relocalisations_;
+  if (blackout_ && index >= blackout_->end() && !first_pose_after_blackout_ &&
+      result.T_world_camera) {
+    first_pose_after_blackout_ = index;
+    first_method_after_blackout_ = to_string(result.method);
+  }
+  if (!result.T_world_camera) ++lost_;
+  if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
+  extraction_ms.push_back(report.extraction_ms);
+  tracking_ms.push_back(report.tracking_ms);
+  tracking_cpu_ms.push_back(report.tracking_cpu_ms);
+  const DynamicReport& dyn = report.dynamic;
+  if (mode_ != DynamicMode::off) flow_ms.push_back(dyn.flow_ms);
+  if (uses_semantics(mode_)) {
+    semantic_wait_ms.push_back(dyn.semantic_wait_ms);
+    if (dyn.mask_age_frames < 0) {
+      ++frames_without_mask;
+    } else {
+      mask_age_frames.push_back(dyn.mask_age_frames);
+      mask_latency_ms.push_back(dyn.mask_latency_ms);
+      // Count each mask's inference once (a mask may serve several frames in real time).
+      if (dyn.semantic_inference_ms != last_inference_ms_)
+        semantic_ms.push_back(dyn.semantic_inference_ms);
+      last_inference_ms_ = dyn.semantic_inference_ms;
+    }
+  }
+  if (dyn.geometry_ran) {
+    geometry_ms.push_back(dyn.geometry_ms);
+    geometry_search_ms.push_back(dyn.geometry_search_ms);
+  }
+  tested_points += dyn.tested_points;
+  dynamic_points += dyn.dynamic_points;
+  masked_keypoints += dyn.masked_keypoints;
+  culled_points += dyn.culled_map_points;
+  ++processed_;
+}
+
+}  // namespace pspslam

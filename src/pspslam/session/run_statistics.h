@@ -1,0 +1,75 @@
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pspslam/dynamic/dynamic_mode.h"
+#include "pspslam/session/run_options.h"
+#include "pspslam/system/system.h"
+
+namespace pspslam {
+
+// {median, mean, p95} of one module's per-frame milliseconds.
+struct TimingSummary {
+  double median = 0.0;
+  double mean = 0.0;
+  double p95 = 0.0;
+  size_t count = 0;
+};
+
+TimingSummary summarize(std::vector<double> values);
+nlohmann::ordered_json to_json(const TimingSummary& timing);
+
+// Accumulates what each frame of a run reports: per-module times, dynamic-feature totals, lost
+// frames, relocalisations and (with a blackout) when poses came back. Read by run_report.h.
+class RunStatistics {
+ public:
+  RunStatistics(DynamicMode mode, std::optional<FrameRange> blackout)
+      : mode_(mode), blackout_(blackout) {}
+
+  // Frame `index` of the sequence; `local_ba_ms` = local BA time finished since the frame
+  // before (0: none).
+  void add_frame(size_t index, const FrameReport& report, double local_ba_ms);
+  // Frames the real-time feed skipped since the last frame.
+  void add_dropped(size_t frames) { realtime_dropped_ += frames; }
+
+  size_t processed() const { return processed_; }
+  size_t lost() const { return lost_; }
+  size_t relocalisations() const { return relocalisations_; }
+  size_t realtime_dropped() const { return realtime_dropped_; }
+  std::optional<size_t> first_pose_after_blackout() const { return first_pose_after_blackout_; }
+  const std::string& first_method_after_blackout() const { return first_method_after_blackout_; }
+
+  std::vector<double> extraction_ms;
+  std::vector<double> tracking_ms;
+  std::vector<double> tracking_cpu_ms;
+  std::vector<double> semantic_ms;  // inference time of each mask used (once per mask)
+  std::vector<double> semantic_wait_ms;
+  std::vector<double> geometry_ms;
+  std::vector<double> geometry_search_ms;
+  std::vector<double> flow_ms;
+  std::vector<double> local_mapping_ms;  // one entry per local BA
+  std::vector<double> mask_age_frames;
+  std::vector<double> mask_latency_ms;
+  size_t tested_points = 0;
+  size_t dynamic_points = 0;
+  size_t masked_keypoints = 0;
+  size_t culled_points = 0;
+  size_t frames_without_mask = 0;
+
+ private:
+  DynamicMode mode_;
+  std::optional<FrameRange> blackout_;
+  size_t processed_ = 0;
+  size_t lost_ = 0;
+  size_t relocalisations_ = 0;
+  size_t realtime_dropped_ = 0;
+  double last_inference_ms_ = -1.0;
+  std::optional<size_t> first_pose_after_blackout_;
+  std::string first_method_after_blackout_;
+};
+
+}  // namespace pspslam

@@ -1,0 +1,206 @@
+#include "pspslam/session/sequence_runner.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "pspslam/core/error.h"
+#include "pspslam/core/interrupt.h"
+#include "pspslam/core/progress.h"
+#include "pspslam/io/point_cloud_ply.h"
+#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/map/map.h"
+#include "pspslam/session/run_report.h"
+#include "pspslam/session/start_watch.h"
+
+namespace pspslam {
+namespace {
+
+size_t frames_to_process(const RgbdSequence& sequence, size_t max_frames) {
+  return max_frames == 0 ? sequence.size() : std::min(sequence.size(), max_frames);
+}
+
+// --export-map / --export-dense, after shutdown (local mapping has refined the poses).
+void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, const Map& map,
+                       std::ostream& out) {
+  const std::vector<std::string> comment = {"pspslam static map, world frame (metres)"};
+  if (!outputs.export_map.empty()) {
+    const std::vector<ColoredPoint> cloud = exporter.map_points(map);
+    write_point_cloud_ply(outputs.export_map, cloud, comment);
+    out << "map export:   " << outputs.export_map.string() << " (" << cloud.size() << " points)\n";
+  }
+  if (!outputs.export_dense.empty()) {
+    const std::vector<ColoredPoint> cloud = exporter.dense_cloud(map, DenseCloudOptions{});
+    write_point_cloud_ply(outputs.export_dense, cloud, comment);
+    out << "map export:   " << outputs.export_dense.string() << " (" << cloud.size()
+        << " points, from " << exporter.remembered_keyframes() << " keyframe images)\n";
+  }
+}
+
+}  // namespace
+
+SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
+    : options_(std::move(options)),
+      out_(out),
+      setup_(open_sequence_with_config(
+          options_.sequence, options_.config,
+          spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr)),
+      frames_(frames_to_process(setup_.sequence, options_.max_frames)),
+      log_(options_.outputs.folder),
+      images_(options_.outputs.masks, options_.outputs.overlays),
+      statistics_(options_.system.dynamic.mode, options_.blackout) {
+  const SystemOptions& system = options_.system;
+  const DynamicOptions& dynamic = system.dynamic;
+  out_ << describe_sequence(setup_);
+  out_ << "dynamic:      " << to_string(dynamic.mode)
+       << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
+       << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)") << "\n";
+  if (!system.map_file.empty()) {
+    out_ << "map:          " << system.map_file.string()
+         << (system.localization_only ? " (localisation only)" : " (extended)") << "\n";
+  }
+  out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off") << "\n";
+  // Keypoint fates cost a second extraction per frame: only for the overlays.
+  if (images_.writes_overlays()) options_.system.record_keypoint_fates = true;
+  system_ = std::make_unique<System>(setup_.config, options_.system);
+  if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
+    exporter_.emplace(setup_.config.camera.pinhole);
+}
+
+SequenceRunner::~SequenceRunner() = default;
+
+RgbdFrame SequenceRunner::load_frame(size_t index) const {
+  RgbdFrame loaded = setup_.sequence.load(index);
+  if (options_.blackout && options_.blackout->covers(index)) {
+    loaded.bgr.setTo(cv::Scalar::all(0));
+    if (!loaded.gray.empty()) loaded.gray.setTo(cv::Scalar::all(0));
+    loaded.depth.setTo(cv::Scalar::all(0));
+  }
+  return loaded;
+}
+
+void SequenceRunner::check_frame_size(size_t index, const RgbdFrame& frame) const {
+  const PinholeCamera& camera = setup_.config.camera.pinhole;
+  if (frame.bgr.cols != camera.width || frame.bgr.rows != camera.height) {
+    throw Error((setup_.sequence.directory() / setup_.sequence.files(index).rgb_file).string() +
+                " is " + std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
+                " but the config " + setup_.config_file.string() + " says camera " +
+                std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+}
+
+RunOutcome SequenceRunner::run() {
+  const RgbdSequence& sequence = setup_.sequence;
+  const bool realtime = options_.system.dynamic.realtime;
+  InterruptGuard interrupt_guard;
+  ProgressBar progress("slam", frames_, std::cerr, options_.progress, realtime);
+  double ba_ms_before = 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
+  // network segments frame i+1 while frame i is tracked.
+  std::optional<RgbdFrame> next;
+  // Frames before the first map: a sequence that never starts (no depth readings) is told why,
+  // after a second of video and again at the end, instead of ending with 0 poses.
+  StartWatch start_watch(static_cast<size_t>(std::max(1.0, setup_.config.camera.fps)));
+  for (size_t i = 0; i < frames_; ++i) {
+    if (interrupted()) break;
+    if (realtime) {
+      // A live camera does not wait: skip to the newest frame whose time has come.
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const Timestamp t0 = sequence.timestamp(0);
+      size_t newest = i;
+      while (newest + 1 < frames_ && sequence.timestamp(newest + 1) - t0 <= elapsed) ++newest;
+      statistics_.add_dropped(newest - i);
+      i = newest;
+      const double wait = sequence.timestamp(i) - t0 - elapsed;
+      if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+      next.reset();
+    }
+    const RgbdFrame frame = next ? std::move(*next) : load_frame(i);
+    next.reset();
+    if (!realtime && i + 1 < frames_) {
+      next = load_frame(i + 1);
+      if (i == 0) system_->announce(frame);
+      system_->announce(*next);
+    }
+    check_frame_size(i, frame);
+    const FrameReport report = system_->process(frame);
+    const TrackResult& result = report.tracking;
+    spdlog::debug(
+        "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "
+        "{} dynamic",
+        i, frame.timestamp, to_string(result.state), to_string(result.method), result.num_inliers,
+        result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
+        report.dynamic.masked_keypoints, report.dynamic.tested_points,
+        report.dynamic.dynamic_points);
+    write_images(i, frame, report);
+    if (exporter_ && result.keyframe_inserted)
+      exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
+                                   system_->last_dynamic_mask());
+    if (start_watch.update(result)) spdlog::warn("{}", start_watch.reason());
+    if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
+    const MappingStats mapping = system_->mapping_stats();
+    const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
+    log_.write(i, frame.timestamp, report, local_ba_ms, mapping);
+    statistics_.add_frame(i, report, mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
+    ba_ms_before = mapping.local_ba_ms_total;
+    progress.update(statistics_.processed(), statistics_.realtime_dropped());
+  }
+  progress.finish();
+  system_->shutdown();
+  if (!options_.outputs.save_map.empty()) {
+    const std::filesystem::path& map_file = options_.outputs.save_map;
+    const auto [saved_keyframes, saved_points] = system_->save_map(map_file);
+    out_ << "map saved:    " << map_file.string() << " (" << saved_keyframes << " keyframes, "
+         << saved_points << " map points, " << std::filesystem::file_size(map_file) / 1024
+         << " KiB)\n";
+  }
+  finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  if (interrupted()) {
+    out_ << "interrupted after " << statistics_.processed() << " of " << frames_
+         << " frames; trajectory.txt holds every pose computed so far\n";
+    return RunOutcome::interrupted;
+  }
+  if (start_watch.never_started()) {  // no frame got a pose, so the trajectory is empty
+    spdlog::error("{}", start_watch.reason());
+    return RunOutcome::never_started;
+  }
+  return RunOutcome::completed;
+}
+
+void SequenceRunner::write_images(size_t index, const RgbdFrame& frame, const FrameReport& report) {
+  if (!images_.writes_masks() && !images_.writes_overlays()) return;
+  const std::filesystem::path& rgb_file = setup_.sequence.files(index).rgb_file;
+  if (images_.writes_masks())
+    images_.write_mask(rgb_file, system_->last_dynamic_mask(), frame.bgr.size());
+  if (images_.writes_overlays())
+    images_.write_overlay(rgb_file, frame.bgr, system_->last_semantic_labels(), report.keypoints);
+}
+
+void SequenceRunner::finish(double seconds) {
+  const std::filesystem::path& out_dir = options_.outputs.folder;
+  write_tum_trajectory(out_dir / "keyframes.txt", system_->keyframe_trajectory());
+  const Trajectory refined = system_->refined_trajectory();
+  write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
+  const MappingStats mapping = system_->mapping_stats();
+  if (exporter_) write_map_exports(options_.outputs, *exporter_, system_->map(), out_);
+  write_run_report({.options = options_,
+                    .statistics = statistics_,
+                    .mapping = mapping,
+                    .sequence = setup_.sequence,
+                    .estimate = estimate_,
+                    .refined = refined,
+                    .frames = frames_,
+                    .seconds = seconds,
+                    .interrupted = interrupted()},
+                   out_);
+}
+
+}  // namespace pspslam

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "pspslam/core/error.h"
+#include "pspslam/session/run_options.h"
+#include "pspslam/session/run_statistics.h"
+#include "pspslam/session/start_watch.h"
+#include "support/test_support.h"
+
+namespace pspslam {
+namespace {
+
+TEST(RunStatistics, TimingSummaryIsMedianMeanAndP95) {
+  std::vector<double> values;
+  for (int i = 20; i >= 1; --i) values.push_back(i);  // 1..20, unsorted
+  const TimingSummary t = summarize(values);
+  EXPECT_EQ(t.count, 20u);
+  EXPECT_DOUBLE_EQ(t.mean, 10.5);
+  EXPECT_DOUBLE_EQ(t.median, 11.0);  // upper median, as the run report always printed
+  EXPECT_DOUBLE_EQ(t.p95, 20.0);     // index floor(0.95 * 20) = 19
+  EXPECT_EQ(summarize({}).count, 0u);
+}
+
+FrameReport frame(bool tracked, TrackingMethod method = TrackingMethod::kMotionModel) {
+  FrameReport report;
+  report.tracking.state = tracked ? TrackingState::kOk : TrackingState::kLost;
+  report.tracking.method = method;
+  if (tracked) report.tracking.T_world_camera = Pose::Identity();
+  report.dynamic.mask_age_frames = 0;
+  report.dynamic.semantic_inference_ms = 50.0;
+  report.dynamic.masked_keypoints = 7;
+  return report;
+}
+
+TEST(RunStatistics, CountsLostFramesRelocalisationsAndTheReturnAfterABlackout) {
+  RunStatistics stats(DynamicMode::full, FrameRange{2, 3});  // frames 2, 3, 4 black
+  stats.add_frame(0, frame(true), 12.0);
+  stats.add_frame(1, frame(true), 0.0);
+  for (size_t i = 2; i < 6; ++i) stats.add_frame(i, frame(false), 0.0);
+  stats.add_frame(6, frame(true, TrackingMethod::kRelocalisation), 0.0);
+  stats.add_frame(7, frame(true), 0.0);
+  EXPECT_EQ(stats.processed(), 8u);
+  EXPECT_EQ(stats.lost(), 4u);
+  EXPECT_EQ(stats.relocalisations(), 1u);
+  ASSERT_TRUE(stats.first_pose_after_blackout());
+  EXPECT_EQ(*stats.first_pose_after_blackout(), 6u);
+  EXPECT_EQ(stats.first_method_after_blackout(), to_string(TrackingMethod::kRelocalisation));
+  EXPECT_EQ(stats.local_mapping_ms.size(), 1u);  // only frames that finished a local BA
+  EXPECT_EQ(stats.masked_keypoints, 56u);
+  EXPECT_EQ(stats.semantic_ms.size(), 1u);  // the same mask inference is counted once
+  EXPECT_EQ(stats.frames_without_mask, 0u);
+}
+
+TEST(StartWatch, WarnsOnceAfterTheGivenFramesAndSaysWhy) {
+  StartWatch watch(3);
+  TrackResult waiting;
+  waiting.keypoints_with_depth = 40;
+  waiting.keypoints_with_depth_needed = 500;
+  EXPECT_FALSE(watch.update(waiting));
+  EXPECT_FALSE(watch.update(waiting));
+  EXPECT_TRUE(watch.update(waiting));
+  EXPECT_FALSE(watch.update(waiting));
+  EXPECT_TRUE(watch.never_started());
+  EXPECT_EQ(watch.reason(),
+            "no map after 4 frames: the best frame had 40 keypoints with a depth reading, 500 "
+            "are needed to start one (are the depth images listed in depth.txt empty?)");
+  TrackResult started;
+  started.state = TrackingState::kOk;
+  watch.update(started);
+  EXPECT_FALSE(watch.never_started());
+}
+
+TEST(RunOutputs, PathsAreCheckedAndCreatedNamingTheFlag) {
+  const auto dir = testing::make_temp_dir("session_outputs");
+  std::ofstream(dir / "plain") << "x";
+  RunOutputs outputs;
+  outputs.folder = dir / "out" / "deep";
+  outputs.export_dense = dir / "clouds" / "dense.ply";
+  prepare_run_outputs(outputs);
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "out" / "deep"));
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "clouds"));
+  outputs.export_map = dir / "plain" / "map.ply";
+  try {
+    prepare_run_outputs(outputs);
+    FAIL() << "an output under a regular file was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--export-map '", 0), 0u) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -36,10 +36,8 @@ cv::Mat dynamic_mask(const LabelMap& labels, const std::vector<int>& dynamic_ids
 std::vector<int> class_ids(const std::vector<std::string>& class_names,
                            const std::vector<std::string>& names, const std::string& context);
 
-// PASCAL VOC colour map (BGR) for label `id`, and a plain colour overlay of `labels` on `bgr`
-// (classes other than 0 blended at `alpha`). Pictures for people use overlay_segmentation
+// PASCAL VOC colour map (BGR) for label `id`. Pictures for people use overlay_segmentation
 // (semantic/overlay.h): dynamic classes strong and outlined, static ones muted, with a legend.
 cv::Vec3b label_color(int id);
-cv::Mat overlay_labels(const cv::Mat& bgr, const LabelMap& labels, double alpha = 0.55);
 
 }  // namespace pspslam

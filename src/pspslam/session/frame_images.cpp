@@ -4,7 +4,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pspslam/core/error.h"
-#include "pspslam/session/keypoint_overlay.h"
 
 namespace pspslam {
 namespace {
@@ -39,7 +38,8 @@ void FrameImageWriter::write_mask(const std::filesystem::path& rgb_file,
 void FrameImageWriter::write_overlay(const std::filesystem::path& rgb_file, const cv::Mat& bgr,
                                      const cv::Mat& labels,
                                      std::span<const KeypointRecord> keypoints) const {
-  write_png(overlays_ / file_name(rgb_file), draw_keypoint_overlay(bgr, labels, keypoints));
+  write_png(overlays_ / file_name(rgb_file),
+            draw_keypoint_overlay(bgr, labels, classes_, keypoints));
 }
 
 }  // namespace pspslam

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pspslam/dynamic/dynamic_pipeline.h"
+#include "pspslam/session/keypoint_overlay.h"
 
 namespace pspslam {
 
@@ -17,6 +18,9 @@ class FrameImageWriter {
  public:
   FrameImageWriter(std::filesystem::path masks, std::filesystem::path overlays)
       : masks_(std::move(masks)), overlays_(std::move(overlays)) {}
+
+  // The segmentation's class names and dynamic classes, for the overlays' colours and legend.
+  void set_classes(OverlayClasses classes) { classes_ = std::move(classes); }
 
   bool writes_masks() const { return !masks_.empty(); }
   bool writes_overlays() const { return !overlays_.empty(); }
@@ -35,6 +39,7 @@ class FrameImageWriter {
  private:
   std::filesystem::path masks_;
   std::filesystem::path overlays_;
+  OverlayClasses classes_;
   cv::Mat mask_;  // reused
 };
 

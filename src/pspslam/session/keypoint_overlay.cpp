@@ -2,8 +2,9 @@
 
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
-#include "pspslam/semantic/segmenter.h"
+#include "pspslam/semantic/overlay.h"
 
 namespace pspslam {
 namespace {
@@ -15,15 +16,15 @@ struct FateStyle {
 };
 
 // Kept keypoints are circles, dropped ones crosses, so the picture reads without colour too.
-// Red and cyan stay visible on the VOC person colour (pink) of the semantic overlay.
-FateStyle style(KeypointFate fate) {
+// Dropped-by-mask crosses are blue-violet, not red: the person class is drawn red.
+FateStyle style_of(KeypointFate fate) {
   switch (fate) {
     case KeypointFate::tracked:
       return {cv::Scalar(0, 210, 0), -1, "tracked (map point match)"};
     case KeypointFate::unmatched:
       return {cv::Scalar(0, 215, 255), -1, "kept, unmatched or outlier"};
     case KeypointFate::semantic:
-      return {cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, "dropped: semantic mask"};
+      return {cv::Scalar(255, 60, 160), cv::MARKER_TILTED_CROSS, "dropped: semantic mask"};
     case KeypointFate::geometry:
       return {cv::Scalar(255, 255, 0), cv::MARKER_TILTED_CROSS, "dropped: geometry test"};
   }
@@ -40,30 +41,30 @@ void draw_marker(cv::Mat& image, const cv::Point2f& position, const FateStyle& s
 
 }  // namespace
 
-void draw_fate_legend(cv::Mat& image, const FateCounts& counts) {
-  constexpr int kLine = 18;
-  const cv::Rect box(6, 6, 250, 10 + kLine * static_cast<int>(counts.size()));
-  cv::Mat area = image(box & cv::Rect(0, 0, image.cols, image.rows));
-  area.convertTo(area, -1, 0.35);  // darkened, so the text reads on any frame
-  for (size_t i = 0; i < counts.size(); ++i) {
-    const FateStyle s = style(static_cast<KeypointFate>(i));
-    const int y = box.y + 14 + kLine * static_cast<int>(i);
-    draw_marker(image, cv::Point2f(static_cast<float>(box.x + 12), static_cast<float>(y - 4)), s);
-    cv::putText(image, std::string(s.label) + " " + std::to_string(counts[i]),
-                cv::Point(box.x + 24, y), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(255, 255, 255),
-                1, cv::LINE_AA);
-  }
-}
-
 cv::Mat draw_keypoint_overlay(const cv::Mat& bgr, const cv::Mat& labels,
+                              const OverlayClasses& classes,
                               std::span<const KeypointRecord> keypoints) {
-  cv::Mat image = labels.empty() ? bgr.clone() : overlay_labels(bgr, labels);
+  OverlayStyle style;
+  style.legend = false;  // one legend below: classes and fates together
+  cv::Mat image =
+      labels.empty() ? bgr.clone()
+                     : overlay_segmentation(bgr, labels, classes.dynamic_ids, classes.names, style);
   FateCounts counts{};
   for (const KeypointRecord& keypoint : keypoints) {
-    draw_marker(image, keypoint.position, style(keypoint.fate));
+    draw_marker(image, keypoint.position, style_of(keypoint.fate));
     ++counts[static_cast<size_t>(keypoint.fate)];
   }
-  draw_fate_legend(image, counts);
+  std::vector<LegendEntry> legend =
+      labels.empty() ? std::vector<LegendEntry>{}
+                     : overlay_legend_entries(labels, classes.dynamic_ids, classes.names, style);
+  for (size_t i = 0; i < counts.size(); ++i) {
+    const FateStyle fate = style_of(static_cast<KeypointFate>(i));
+    const cv::Scalar& c = fate.color;
+    legend.push_back(
+        {std::string(fate.label) + " " + std::to_string(counts[i]),
+         cv::Vec3b(static_cast<uchar>(c[0]), static_cast<uchar>(c[1]), static_cast<uchar>(c[2]))});
+  }
+  draw_legend(image, legend);
   return image;
 }
 

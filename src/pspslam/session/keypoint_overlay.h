@@ -3,6 +3,8 @@
 #include <array>
 #include <opencv2/core.hpp>
 #include <span>
+#include <string>
+#include <vector>
 
 #include "pspslam/dynamic/dynamic_pipeline.h"
 
@@ -11,13 +13,18 @@ namespace pspslam {
 // Keypoints per fate, indexed by KeypointFate.
 using FateCounts = std::array<int, 4>;
 
-// A picture of one frame for `pspslam run --save-overlays`: the semantic overlay of `labels`
-// (semantic/ overlay_labels; the plain frame when `labels` is empty), every keypoint marked by
-// its fate (kept: circle, dropped: cross) and a legend with the counts.
-cv::Mat draw_keypoint_overlay(const cv::Mat& bgr, const cv::Mat& labels,
-                              std::span<const KeypointRecord> keypoints);
+// The classes of the segmentation behind an overlay (names by label id, and which are dynamic).
+struct OverlayClasses {
+  std::vector<std::string> names;
+  std::vector<int> dynamic_ids;
+};
 
-// The legend, top left. Kept in one function so that a shared legend helper can replace it.
-void draw_fate_legend(cv::Mat& image, const FateCounts& counts);
+// A picture of one frame for `pspslam run --save-overlays`: the segmentation overlay of `labels`
+// (semantic/overlay.h: dynamic classes strong and outlined, static ones muted; the plain frame
+// when `labels` is empty), every keypoint marked by its fate (kept: circle, dropped: cross) and
+// one legend: the classes present, then the fates with their counts.
+cv::Mat draw_keypoint_overlay(const cv::Mat& bgr, const cv::Mat& labels,
+                              const OverlayClasses& classes,
+                              std::span<const KeypointRecord> keypoints);
 
 }  // namespace pspslam

@@ -16,6 +16,8 @@
 #include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/map/map.h"
+#include "pspslam/semantic/segmenter.h"
+#include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/session/run_report.h"
 #include "pspslam/session/start_watch.h"
 
@@ -67,7 +69,16 @@ SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
   }
   out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off") << "\n";
   // Keypoint fates cost a second extraction per frame: only for the overlays.
-  if (images_.writes_overlays()) options_.system.record_keypoint_fates = true;
+  if (images_.writes_overlays()) {
+    options_.system.record_keypoint_fates = true;
+    if (uses_semantics(dynamic.mode)) {
+      const SegmenterMetadata model = load_segmenter_metadata(dynamic.model);
+      const std::vector<std::string>& names = dynamic.semantic.dynamic_classes.empty()
+                                                  ? model.dynamic_classes
+                                                  : dynamic.semantic.dynamic_classes;
+      images_.set_classes({model.classes, class_ids(model.classes, names, model.file.string())});
+    }
+  }
   system_ = std::make_unique<System>(setup_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(setup_.config.camera.pinhole);

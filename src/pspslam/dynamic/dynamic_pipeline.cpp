@@ -4,6 +4,7 @@
 #include <span>
 #include <utility>
 
+#include "pspslam/core/clock.h"
 #include "pspslam/dynamic/keypoint_fusion.h"
 #include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
@@ -14,15 +15,6 @@
 #include "pspslam/semantic/semantic_thread.h"
 
 namespace pspslam {
-namespace {
-
-double milliseconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-}  // namespace
-
 const char* to_string(KeypointFate fate) {
   switch (fate) {
     case KeypointFate::tracked:

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/config/yaml_section.h"
+#include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
 
 namespace pspslam {
@@ -26,10 +27,7 @@ struct Stopwatch {
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
     return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
   }
-  double wall_ms() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall)
-        .count();
-  }
+  double wall_ms() const { return milliseconds_since(wall); }
   double cpu_ms() const { return thread_cpu_ms() - cpu; }
 };
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "pspslam/core/clock.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/mapping/local_mapping.h"
@@ -76,8 +77,7 @@ void LoopClosing::process(const std::shared_ptr<KeyFrame>& keyframe) {
   if (!candidates.empty()) loop = detector_.verify(keyframe, candidates);
   {
     std::lock_guard lock(mutex_);
-    stats_.detection_ms_total +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats_.detection_ms_total += milliseconds_since(start);
   }
   if (loop) close_loop(*loop);
 }

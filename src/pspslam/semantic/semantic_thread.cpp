@@ -3,17 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
 
 namespace pspslam {
-namespace {
-
-double ms_since(SemanticThread::Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(SemanticThread::Clock::now() - t0).count();
-}
-
-}  // namespace
-
 SemanticThread::SemanticThread(std::unique_ptr<Segmenter> segmenter, const SemanticParams& params)
     : segmenter_(std::move(segmenter)),
       dilation_px_(params.mask_dilation_px),
@@ -98,8 +91,8 @@ void SemanticThread::run() {
       done_cv_.notify_all();
       continue;
     }
-    result->inference_ms = ms_since(t0);
-    result->latency_ms = ms_since(job.submitted);
+    result->inference_ms = milliseconds_since(t0);
+    result->latency_ms = milliseconds_since(job.submitted);
     {
       std::lock_guard lock(mutex_);
       history_.push_back(std::move(result));

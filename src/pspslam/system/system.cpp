@@ -61,6 +61,7 @@
 #include <optional>
 #include <vector>
 
+#include "pspslam/core/clock.h"
 #include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/io/rgbd_sequence.h"
@@ -83,11 +84,6 @@ double thread_cpu_ms() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
-
-double milliseconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 }  // namespace

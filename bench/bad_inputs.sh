@@ -108,6 +108,9 @@ row "--out is a regular file" 2 -- "$cli" run --sequence seq --out a_file
 row "--save-map names a folder" 2 -- $R --sequence seq --save-map seq
 row "--export-map below a regular file" 2 -- $R --sequence seq --export-map a_file/map.ply
 row "--export-dense below a regular file" 2 -- $R --sequence seq --export-dense a_file/dense.ply
+row "--save-masks below a regular file" 2 -- $R --sequence seq --save-masks a_file/masks
+row "--save-overlays is a regular file" 2 -- $R --sequence seq --save-overlays a_file
+row "eval --title without its value" 2 -- "$cli" eval --gt seq/groundtruth.txt --est good/trajectory.txt --title
 row "--log-level chatty" 2 -- "$cli" --log-level chatty run --sequence seq
 row "sequence folder missing" 2 -- $R --sequence nowhere
 row "no rgb.txt / depth.txt" 2 -- $R --sequence no_lists

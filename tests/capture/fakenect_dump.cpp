@@ -35,7 +35,9 @@ void write_fakenect_dump(const RgbdSequence& sequence, const std::filesystem::pa
     const double elapsed = sequence.timestamp(i) - sequence.timestamp(0);
     const auto ticks = static_cast<uint32_t>(options.first_ticks +
                                              static_cast<uint64_t>(std::llround(elapsed * 60e6)));
-    const double record_time = 1000.0 + static_cast<double>(i) * options.interval_s;
+    const double record_time =
+        1000.0 + static_cast<double>(i) * options.interval_s +
+        (options.pause_s > 0 && i > options.pause_after ? options.pause_s : 0);
     cv::Mat raw(frame.depth.size(), CV_16UC1);
     for (int y = 0; y < raw.rows; ++y)
       for (int x = 0; x < raw.cols; ++x)

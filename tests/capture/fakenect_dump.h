@@ -21,6 +21,9 @@ struct FakenectDumpOptions {
   size_t frames = 0;  // 0 = all
   double interval_s = 1.0 / 30.0;
   uint32_t first_ticks = 0;
+  // The replay stalls this long after frame `pause_after` (a camera that hangs); 0 = never.
+  size_t pause_after = 0;
+  double pause_s = 0.0;
 };
 
 void write_fakenect_dump(const RgbdSequence& sequence, const std::filesystem::path& dir,

@@ -248,6 +248,44 @@ TEST_F(Fakenect, RunAtThirtyHertzCountsEveryDroppedFrame) {
             << " dropped\n";
 }
 
+// A camera that stays connected but sends nothing (here a replay that stalls for 5 s after frame
+// 5) ends the run after 3 s of silence like an unplug: status 4, the reason, every output.
+TEST_F(Fakenect, SilentCameraEndsTheRunAfterThreeSeconds) {
+  make_sequence_and_dumps();
+  const RgbdSequence sequence = RgbdSequence::open(root() / "seq");
+  testing::write_fakenect_dump(
+      sequence, root() / "stall",
+      {.frames = 10, .interval_s = 0.05, .pause_after = 5, .pause_s = 5.0});
+  const Result run =
+      replayed(root() / "stall", "run --camera freenect --dynamic off --config " +
+                                     (root() / "seq/config.yaml").string() + " --out " +
+                                     (root() / "stall_out").string() + " -q");
+  EXPECT_EQ(run.status, 4) << run.output;
+  EXPECT_TRUE(contains(run.output,
+                       "error: camera freenect:0 stopped: no frame for 3.0 s "
+                       "(unplugged or hung) after 6 frames"))
+      << run.output;
+  const nlohmann::json stats = read_json(root() / "stall_out/stats.json");
+  EXPECT_EQ(stats["frames"], 6);
+  EXPECT_EQ(stats["input"]["disconnected"], true);
+}
+
+// Ctrl-C ends a camera run with status 130 and every output, like a folder run.
+TEST_F(Fakenect, InterruptedCameraRunWritesEveryOutput) {
+  make_sequence_and_dumps();
+  const Result run =
+      shell(testing::fakenect_environment(root() / "dump") + PSPSLAM_CLI_PATH +
+            " run --camera freenect --dynamic off --config " +
+            (root() / "seq/config.yaml").string() + " --out " + (root() / "int_out").string() +
+            " -q & pid=$!; sleep 3; kill -INT $pid; wait $pid");
+  EXPECT_EQ(run.status, 130) << run.output;
+  EXPECT_TRUE(contains(run.output, "interrupted after ")) << run.output;
+  const nlohmann::json stats = read_json(root() / "int_out/stats.json");
+  EXPECT_EQ(stats["interrupted"], true);
+  EXPECT_GE(stats["frames"].get<size_t>(), 3u);
+  EXPECT_LT(stats["frames"].get<size_t>(), kFrames);
+}
+
 // Ctrl-C ends an open-ended recording with status 0 and a valid folder.
 TEST_F(Fakenect, InterruptedRecordingIsAValidSequence) {
   make_sequence_and_dumps();

@@ -1,5 +1,7 @@
-// `pspslam run`: SLAM on an RGB-D sequence. This file only turns the flags into RunOptions; the
-// run itself (frame loop, output files, statistics) is SequenceRunner (session/), which writes
+// `pspslam run`: SLAM on an RGB-D sequence, or on a live camera with --camera (capture/: the
+// frames come from its FrameSource instead of the folder). This file only turns the flags into
+// RunOptions; the run itself (frame loop, output files, statistics) is SequenceRunner
+// (session/), which writes
 // (per-frame masks and overlays with --save-masks / --save-overlays, session/frame_images.h)
 // into OUT/
 //   trajectory.txt   T_world_camera of every tracked frame (TUM), flushed per frame so an

@@ -247,7 +247,8 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   size_t delivered = 0;
   size_t last = 0;
   while (const std::optional<RgbdFrame> frame = paced.next()) {
-    if (delivered++ > 0) {
+    // Skips at least one frame each time, except where it reaches the last frame.
+    if (delivered++ > 0 && frame->index + 1 < 20) {
       EXPECT_GT(frame->index, last + 1);
     }
     last = frame->index;

@@ -66,8 +66,9 @@ class Fakenect : public ::testing::Test {
 
   // seq/: the sequence; dump/: all of it played at 4 frames/s (slow enough that a run keeps up
   // and drops nothing), the device clock starting half a second before its 32-bit wrap;
-  // fast/: the same at 10 frames/s (for recording); live/: at the Kinect's 30 frames/s;
-  // short/: the first 12 frames at 20 frames/s.
+  // fast/: the same at 6.7 frames/s (for recording); live/: at the Kinect's 30 frames/s;
+  // short/: the first 12 frames at 5 frames/s. (The slow rates keep runs and recordings free of
+  // drops also while ctest runs other tests beside them.)
   void make_sequence_and_dumps() {
     const Result synth = pspslam("synth --out " + (root_ / "seq").string() + " --frames " +
                                  std::to_string(kFrames) + " --bodies 2 --seed 4 -q");
@@ -75,9 +76,9 @@ class Fakenect : public ::testing::Test {
     const RgbdSequence sequence = RgbdSequence::open(root_ / "seq");
     testing::write_fakenect_dump(sequence, root_ / "dump",
                                  {.interval_s = 0.25, .first_ticks = 0xffffffffu - 30'000'000u});
-    testing::write_fakenect_dump(sequence, root_ / "fast", {.interval_s = 0.1});
+    testing::write_fakenect_dump(sequence, root_ / "fast", {.interval_s = 0.15});
     testing::write_fakenect_dump(sequence, root_ / "live", {.interval_s = 1.0 / 30.0});
-    testing::write_fakenect_dump(sequence, root_ / "short", {.frames = 12, .interval_s = 0.05});
+    testing::write_fakenect_dump(sequence, root_ / "short", {.frames = 12, .interval_s = 0.2});
   }
   const std::filesystem::path& root() const { return root_; }
 
@@ -253,9 +254,8 @@ TEST_F(Fakenect, RunAtThirtyHertzCountsEveryDroppedFrame) {
 TEST_F(Fakenect, SilentCameraEndsTheRunAfterThreeSeconds) {
   make_sequence_and_dumps();
   const RgbdSequence sequence = RgbdSequence::open(root() / "seq");
-  testing::write_fakenect_dump(
-      sequence, root() / "stall",
-      {.frames = 10, .interval_s = 0.05, .pause_after = 5, .pause_s = 5.0});
+  testing::write_fakenect_dump(sequence, root() / "stall",
+                               {.frames = 10, .interval_s = 0.2, .pause_after = 5, .pause_s = 5.0});
   const Result run =
       replayed(root() / "stall", "run --camera freenect --dynamic off --config " +
                                      (root() / "seq/config.yaml").string() + " --out " +

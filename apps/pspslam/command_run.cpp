@@ -1,5 +1,7 @@
-// `pspslam run`: SLAM on an RGB-D sequence. This file only turns the flags into RunOptions; the
-// run itself (frame loop, output files, statistics) is SequenceRunner (session/), which writes
+// `pspslam run`: SLAM on an RGB-D sequence, or on a live camera with --camera (capture/: the
+// frames come from its FrameSource instead of the folder). This file only turns the flags into
+// RunOptions; the run itself (frame loop, output files, statistics) is SequenceRunner
+// (session/), which writes
 // (per-frame masks and overlays with --save-masks / --save-overlays, session/frame_images.h)
 // into OUT/
 //   trajectory.txt   T_world_camera of every tracked frame (TUM), flushed per frame so an
@@ -24,6 +26,8 @@
 
 #include "commands.h"
 #include "flag_checks.h"
+#include "pspslam/capture/camera_spec.h"
+#include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/place/place_recognition.h"
@@ -38,6 +42,8 @@ namespace {
 constexpr int kInterruptedExit = 130;
 // The whole sequence ran and no frame ever started a map: nothing was tracked.
 constexpr int kNeverStartedExit = 3;
+// --camera: the camera stopped delivering (unplugged); the outputs hold every frame so far.
+constexpr int kCameraLostExit = 4;
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
 // with a warning that says which model is missing and how to get it; an explicitly requested
@@ -95,6 +101,7 @@ FrameRange parse_blackout(const std::string& value) {
 
 struct RunFlags {
   std::string sequence;
+  std::string camera;
   std::string config;
   std::string out = "pspslam_out";
   size_t max_frames = 0;
@@ -161,8 +168,21 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   system.place.loop_closing =
       !system.localization_only && parse_loop_closing(flags.loop_closing, system.place.vocabulary);
 
-  SequenceRunner runner(std::move(options), std::cout);
+  // A live camera, or the sequence folder (opened by the runner).
+  std::optional<RunInput> camera;
+  if (!flags.camera.empty()) {
+    const CameraSpec spec = parse_camera_spec(flags.camera);
+    camera.emplace();
+    camera->config_file =
+        flags.config.empty() ? camera_config_preset(spec) : std::filesystem::path(flags.config);
+    camera->config = load_config(camera->config_file);
+    camera->source = open_camera(spec);
+  }
+  SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
+                                 : SequenceRunner(std::move(options), std::cout);
   switch (runner.run()) {
+    case RunOutcome::disconnected:
+      return kCameraLostExit;
     case RunOutcome::interrupted:
       return kInterruptedExit;
     case RunOutcome::never_started:
@@ -182,7 +202,16 @@ Command add_run_command(CLI::App& root) {
       "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv and "
       "OUT/stats.json. With ground truth, prints ATE.");
   auto flags = std::make_shared<RunFlags>();
-  app->add_option("--sequence", flags->sequence, "sequence folder")->required();
+  CLI::Option* sequence = app->add_option("--sequence", flags->sequence, "sequence folder");
+  app->add_option("--camera", flags->camera,
+                  "read a live camera instead of a folder: freenect[:INDEX] (Kinect v1 through "
+                  "libfreenect; config: --config, else config/kinect_v1.yaml)")
+      ->excludes(sequence);
+  // One input is required; checked while parsing, so nothing is created without one.
+  app->callback([flags] {
+    if (flags->sequence.empty() && flags->camera.empty())
+      throw CLI::RequiredError("--sequence (or --camera)");
+  });
   app->add_option("--config", flags->config,
                   "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
                   "else required; presets in config/)");

@@ -20,6 +20,7 @@ struct Command {
 };
 
 Command add_run_command(CLI::App& root);
+Command add_record_command(CLI::App& root);
 Command add_eval_command(CLI::App& root);
 Command add_synth_command(CLI::App& root);
 Command add_segment_command(CLI::App& root);

@@ -222,6 +222,7 @@ RgbdFrame RgbdSequence::load(size_t i) const {
   frame.index = i;
   frame.timestamp = files.rgb_timestamp;
   frame.depth_timestamp = files.depth_timestamp;
+  frame.name = files.rgb_file;
   const std::filesystem::path rgb_path = dir_ / files.rgb_file;
   const std::filesystem::path depth_path = dir_ / files.depth_file;
   frame.bgr = read_color_image(rgb_path);

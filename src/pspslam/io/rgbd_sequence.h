@@ -37,6 +37,9 @@ struct RgbdFrame {
   cv::Mat bgr;    // CV_8UC3
   cv::Mat gray;   // CV_8UC1 (empty unless SequenceOptions::load_gray)
   cv::Mat depth;  // CV_32FC1 metres, 0 = no reading
+  // The colour image's file relative to its sequence ("rgb/1.5.png"); per-frame pictures are
+  // named after it. A live camera frame is named as `pspslam record` would store it.
+  std::string name;
 };
 
 // File names of one associated frame, relative to the sequence directory as listed.

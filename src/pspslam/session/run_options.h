@@ -34,7 +34,7 @@ void prepare_run_outputs(const RunOutputs& outputs);
 
 // One run of the system over a recorded sequence (`pspslam run`).
 struct RunOptions {
-  std::filesystem::path sequence;
+  std::filesystem::path sequence;  // read by SequenceRunner(RunOptions, ...) only
   // Config YAML; none: SEQUENCE/config.yaml (io/sequence_setup.h).
   std::optional<std::filesystem::path> config;
   size_t max_frames = 0;  // 0 = all
@@ -50,6 +50,7 @@ enum class RunOutcome {
   completed,
   interrupted,    // Ctrl-C / SIGTERM: the outputs hold every frame processed so far
   never_started,  // the whole sequence ran and no frame ever started a map
+  disconnected,   // the camera stopped delivering (unplugged): the outputs hold every frame so far
 };
 
 }  // namespace pspslam

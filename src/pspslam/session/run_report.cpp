@@ -10,7 +10,6 @@
 #include "pspslam/core/error.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/eval/stats.h"
-#include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/session/frame_log.h"
 
 namespace pspslam {
@@ -54,8 +53,8 @@ nlohmann::ordered_json report_blackout(const RunReportInput& input, const FrameR
     out << "no pose after the return\n";
   }
   std::optional<ErrorStats> after_return;
-  if (ate_tracked && blackout.end() < input.frames) {
-    const Timestamp returned = input.sequence.timestamp(blackout.end());
+  if (ate_tracked && input.blackout_return) {
+    const Timestamp returned = *input.blackout_return;
     std::vector<double> errors;
     for (const AtePair& pair : ate_tracked->pairs) {
       if (pair.est_timestamp >= returned) errors.push_back(pair.error);
@@ -110,13 +109,14 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
       << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
   std::optional<AteResult> ate_tracked;
   std::optional<AteResult> ate_refined;
-  if (input.sequence.ground_truth() && input.estimate.size() >= 3) {
+  const std::optional<Trajectory>& ground_truth = input.source.ground_truth();
+  if (ground_truth && input.estimate.size() >= 3) {
     const std::tuple<const char*, const Trajectory*, std::optional<AteResult>*> evaluated[] = {
         {"trajectory.txt        ", &input.estimate, &ate_tracked},
         {"trajectory_refined.txt", &input.refined, &ate_refined}};
     for (const auto& [name, poses, slot] : evaluated) {
       try {
-        const AteResult ate = compute_ate(*input.sequence.ground_truth(), *poses);
+        const AteResult ate = compute_ate(*ground_truth, *poses);
         std::snprintf(line, sizeof(line),
                       "ATE %s (SE(3) aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
                       "%.4f m, max %.4f m\n",
@@ -163,9 +163,11 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                 stats.masked_keypoints, stats.culled_points, mask_age.median, mask_latency.median,
                 stats.frames_without_mask, stats.realtime_dropped());
   out << line;
+  const FrameSourceStats source = input.source.stats();
+  if (source.disconnected) out << "input:        " << source.end_reason << "\n";
 
   const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
-  nlohmann::ordered_json json = {{"sequence", input.sequence.directory().string()},
+  nlohmann::ordered_json json = {{"sequence", input.source.name()},
                                  {"mode", to_string(system.dynamic.mode)},
                                  {"realtime", system.dynamic.realtime},
                                  {"interrupted", input.interrupted},
@@ -174,6 +176,10 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                                  {"relocalisations", stats.relocalisations()}};
   if (!blackout_json.is_null()) json["blackout"] = blackout_json;
   json["realtime_dropped_frames"] = stats.realtime_dropped();
+  // How the input ended: a camera that was unplugged or fell silent says so here.
+  json["input"] = {{"dropped_frames", source.dropped},
+                   {"disconnected", source.disconnected},
+                   {"end_reason", source.end_reason}};
   json["seconds"] = seconds;
   json["fps"] = fps;
   json["timing_ms"] = {

@@ -1,26 +1,28 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <ostream>
 
 #include "pspslam/core/types.h"
+#include "pspslam/io/frame_source.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam {
 
-class RgbdSequence;
-
 // What the end of a run knows.
 struct RunReportInput {
   const RunOptions& options;
   const RunStatistics& statistics;
   const MappingStats& mapping;
-  const RgbdSequence& sequence;
+  const FrameSource& source;   // ground truth, name and how the input ended
   const Trajectory& estimate;  // the poses of trajectory.txt
   const Trajectory& refined;   // trajectory_refined.txt
-  size_t frames = 0;           // frames the run was to process
+  size_t frames = 0;           // frames the run was to process (0: until the input ended)
+  // Timestamp of the first frame after a --blackout, when the run got there.
+  std::optional<Timestamp> blackout_return;
   double seconds = 0.0;
   bool interrupted = false;
 };

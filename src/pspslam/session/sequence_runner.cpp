@@ -6,7 +6,6 @@
 #include <chrono>
 #include <iostream>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include "pspslam/core/progress.h"
 #include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/sequence_source.h"
 #include "pspslam/map/map.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
@@ -23,10 +23,6 @@
 
 namespace pspslam {
 namespace {
-
-size_t frames_to_process(const RgbdSequence& sequence, size_t max_frames) {
-  return max_frames == 0 ? sequence.size() : std::min(sequence.size(), max_frames);
-}
 
 // --export-map / --export-dense, after shutdown (local mapping has refined the poses).
 void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, const Map& map,
@@ -47,19 +43,32 @@ void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, c
 
 }  // namespace
 
+RunInput open_sequence_input(const RunOptions& options) {
+  SequenceSetup setup =
+      open_sequence_with_config(options.sequence, options.config,
+                                spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr);
+  RunInput input{setup.config_file, setup.config, nullptr};
+  input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
+                                                  options.system.dynamic.realtime);
+  return input;
+}
+
 SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
+    : SequenceRunner(open_sequence_input(options), options, out) {}
+
+SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream& out)
     : options_(std::move(options)),
       out_(out),
-      setup_(open_sequence_with_config(
-          options_.sequence, options_.config,
-          spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr)),
-      frames_(frames_to_process(setup_.sequence, options_.max_frames)),
+      input_(std::move(input)),
+      frames_(input_.source->frame_count().value_or(options_.max_frames)),
       log_(options_.outputs.folder),
       images_(options_.outputs.masks, options_.outputs.overlays),
       statistics_(options_.system.dynamic.mode, options_.blackout) {
   const SystemOptions& system = options_.system;
   const DynamicOptions& dynamic = system.dynamic;
-  out_ << describe_sequence(setup_);
+  if (options_.max_frames > 0 && (frames_ == 0 || frames_ > options_.max_frames))
+    frames_ = options_.max_frames;
+  out_ << input_.source->describe();
   out_ << "dynamic:      " << to_string(dynamic.mode)
        << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
        << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)") << "\n";
@@ -79,38 +88,45 @@ SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
       images_.set_classes({model.classes, class_ids(model.classes, names, model.file.string())});
     }
   }
-  system_ = std::make_unique<System>(setup_.config, options_.system);
+  system_ = std::make_unique<System>(input_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
-    exporter_.emplace(setup_.config.camera.pinhole);
+    exporter_.emplace(input_.config.camera.pinhole);
 }
 
 SequenceRunner::~SequenceRunner() = default;
 
-RgbdFrame SequenceRunner::load_frame(size_t index) const {
-  RgbdFrame loaded = setup_.sequence.load(index);
-  if (options_.blackout && options_.blackout->covers(index)) {
-    loaded.bgr.setTo(cv::Scalar::all(0));
-    if (!loaded.gray.empty()) loaded.gray.setTo(cv::Scalar::all(0));
-    loaded.depth.setTo(cv::Scalar::all(0));
+std::optional<RgbdFrame> SequenceRunner::next_frame() {
+  if (frames_ > 0 && delivered_ >= frames_) return std::nullopt;
+  std::optional<RgbdFrame> loaded = input_.source->next();
+  if (!loaded) return std::nullopt;
+  ++delivered_;
+  const size_t before = statistics_.realtime_dropped();
+  statistics_.add_dropped(input_.source->stats().dropped - before);
+  if (options_.blackout && options_.blackout->covers(loaded->index)) {
+    loaded->bgr.setTo(cv::Scalar::all(0));
+    if (!loaded->gray.empty()) loaded->gray.setTo(cv::Scalar::all(0));
+    loaded->depth.setTo(cv::Scalar::all(0));
   }
+  if (options_.blackout && !blackout_return_ && loaded->index >= options_.blackout->end())
+    blackout_return_ = loaded->timestamp;
   return loaded;
 }
 
-void SequenceRunner::check_frame_size(size_t index, const RgbdFrame& frame) const {
-  const PinholeCamera& camera = setup_.config.camera.pinhole;
+void SequenceRunner::check_frame_size(const RgbdFrame& frame) const {
+  const PinholeCamera& camera = input_.config.camera.pinhole;
   if (frame.bgr.cols != camera.width || frame.bgr.rows != camera.height) {
-    throw Error((setup_.sequence.directory() / setup_.sequence.files(index).rgb_file).string() +
-                " is " + std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
-                " but the config " + setup_.config_file.string() + " says camera " +
+    throw Error((std::filesystem::path(input_.source->name()) / frame.name).string() + " is " +
+                std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
+                " but the config " + input_.config_file.string() + " says camera " +
                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
 }
 
 RunOutcome SequenceRunner::run() {
-  const RgbdSequence& sequence = setup_.sequence;
   const bool realtime = options_.system.dynamic.realtime;
   InterruptGuard interrupt_guard;
-  ProgressBar progress("slam", frames_, std::cerr, options_.progress, realtime);
+  // A live stream of unknown length has no bar to fill.
+  ProgressBar progress("slam", frames_, std::cerr, options_.progress && frames_ > 0, realtime);
   double ba_ms_before = 0.0;
   const auto start = std::chrono::steady_clock::now();
   // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
@@ -118,30 +134,19 @@ RunOutcome SequenceRunner::run() {
   std::optional<RgbdFrame> next;
   // Frames before the first map: a sequence that never starts (no depth readings) is told why,
   // after a second of video and again at the end, instead of ending with 0 poses.
-  StartWatch start_watch(static_cast<size_t>(std::max(1.0, setup_.config.camera.fps)));
-  for (size_t i = 0; i < frames_; ++i) {
-    if (interrupted()) break;
-    if (realtime) {
-      // A live camera does not wait: skip to the newest frame whose time has come.
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const Timestamp t0 = sequence.timestamp(0);
-      size_t newest = i;
-      while (newest + 1 < frames_ && sequence.timestamp(newest + 1) - t0 <= elapsed) ++newest;
-      statistics_.add_dropped(newest - i);
-      i = newest;
-      const double wait = sequence.timestamp(i) - t0 - elapsed;
-      if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
-      next.reset();
-    }
-    const RgbdFrame frame = next ? std::move(*next) : load_frame(i);
+  StartWatch start_watch(static_cast<size_t>(std::max(1.0, input_.config.camera.fps)));
+  for (bool first = true; !interrupted(); first = false) {
+    std::optional<RgbdFrame> current = next ? std::move(next) : next_frame();
     next.reset();
-    if (!realtime && i + 1 < frames_) {
-      next = load_frame(i + 1);
-      if (i == 0) system_->announce(frame);
-      system_->announce(*next);
+    if (!current) break;
+    const RgbdFrame& frame = *current;
+    if (!realtime) {
+      next = next_frame();
+      if (first) system_->announce(frame);
+      if (next) system_->announce(*next);
     }
-    check_frame_size(i, frame);
+    const size_t i = frame.index;
+    check_frame_size(frame);
     const FrameReport report = system_->process(frame);
     const TrackResult& result = report.tracking;
     spdlog::debug(
@@ -151,7 +156,7 @@ RunOutcome SequenceRunner::run() {
         result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
         report.dynamic.masked_keypoints, report.dynamic.tested_points,
         report.dynamic.dynamic_points);
-    write_images(i, frame, report);
+    write_images(frame, report);
     if (exporter_ && result.keyframe_inserted)
       exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
                                    system_->last_dynamic_mask());
@@ -175,9 +180,16 @@ RunOutcome SequenceRunner::run() {
   }
   finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (interrupted()) {
-    out_ << "interrupted after " << statistics_.processed() << " of " << frames_
+    out_ << "interrupted after " << statistics_.processed()
+         << (frames_ > 0 ? " of " + std::to_string(frames_) : std::string())
          << " frames; trajectory.txt holds every pose computed so far\n";
     return RunOutcome::interrupted;
+  }
+  const FrameSourceStats source = input_.source->stats();
+  if (source.disconnected) {
+    spdlog::error("{} after {} frames; the outputs hold every pose computed so far",
+                  source.end_reason, statistics_.processed());
+    return RunOutcome::disconnected;
   }
   if (start_watch.never_started()) {  // no frame got a pose, so the trajectory is empty
     spdlog::error("{}", start_watch.reason());
@@ -186,9 +198,9 @@ RunOutcome SequenceRunner::run() {
   return RunOutcome::completed;
 }
 
-void SequenceRunner::write_images(size_t index, const RgbdFrame& frame, const FrameReport& report) {
+void SequenceRunner::write_images(const RgbdFrame& frame, const FrameReport& report) {
   if (!images_.writes_masks() && !images_.writes_overlays()) return;
-  const std::filesystem::path& rgb_file = setup_.sequence.files(index).rgb_file;
+  const std::filesystem::path rgb_file = frame.name;
   if (images_.writes_masks())
     images_.write_mask(rgb_file, system_->last_dynamic_mask(), frame.bgr.size());
   if (images_.writes_overlays())
@@ -205,10 +217,11 @@ void SequenceRunner::finish(double seconds) {
   write_run_report({.options = options_,
                     .statistics = statistics_,
                     .mapping = mapping,
-                    .sequence = setup_.sequence,
+                    .source = *input_.source,
                     .estimate = estimate_,
                     .refined = refined,
                     .frames = frames_,
+                    .blackout_return = blackout_return_,
                     .seconds = seconds,
                     .interrupted = interrupted()},
                    out_);

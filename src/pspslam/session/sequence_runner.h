@@ -1,12 +1,14 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <ostream>
 
+#include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
-#include "pspslam/io/sequence_setup.h"
+#include "pspslam/io/frame_source.h"
 #include "pspslam/session/frame_images.h"
 #include "pspslam/session/frame_log.h"
 #include "pspslam/session/run_options.h"
@@ -18,16 +20,30 @@ namespace pspslam {
 
 struct RgbdFrame;
 
-// Runs the System over a recorded sequence and writes the run's files (`pspslam run`): the
+// What a run reads: its frames and the camera config they are processed with.
+struct RunInput {
+  std::filesystem::path config_file;
+  SystemConfig config;
+  std::unique_ptr<FrameSource> source;
+};
+
+// options.sequence opened with its config (io/sequence_setup.h) as a SequenceSource, paced when
+// options.system.dynamic.realtime.
+RunInput open_sequence_input(const RunOptions& options);
+
+// Runs the System over a stream of frames and writes the run's files (`pspslam run`): the
 // per-frame log (frame_log.h) while it goes, then keyframes.txt, trajectory_refined.txt, the map
 // files asked for and the report (run_report.h). Frames are fed as a deterministic run wants
 // them (one ahead, announced to the semantic thread) or, with options.system.dynamic.realtime,
-// at the sequence's rate, dropping the frames whose time has passed.
+// as the source delivers them (a paced sequence or a camera drops the frames it cannot hand over
+// in time). Where the frames come from is the FrameSource's business.
 class SequenceRunner {
  public:
-  // Opens the sequence and its config, creates the per-frame files and the System; prints the
-  // setup to `out`. Call prepare_run_outputs() first. Throws pspslam::Error.
+  // Opens options.sequence (open_sequence_input) and runs over it.
   SequenceRunner(RunOptions options, std::ostream& out);
+  // Creates the per-frame files and the System for `input`; prints the setup to `out`. Call
+  // prepare_run_outputs() first. Throws pspslam::Error.
+  SequenceRunner(RunInput input, RunOptions options, std::ostream& out);
   ~SequenceRunner();
   SequenceRunner(const SequenceRunner&) = delete;
   SequenceRunner& operator=(const SequenceRunner&) = delete;
@@ -37,15 +53,17 @@ class SequenceRunner {
   RunOutcome run();
 
  private:
-  RgbdFrame load_frame(size_t index) const;
-  void check_frame_size(size_t index, const RgbdFrame& frame) const;
-  void write_images(size_t index, const RgbdFrame& frame, const FrameReport& report);
+  std::optional<RgbdFrame> next_frame();
+  void check_frame_size(const RgbdFrame& frame) const;
+  void write_images(const RgbdFrame& frame, const FrameReport& report);
   void finish(double seconds);
 
   RunOptions options_;
   std::ostream& out_;
-  SequenceSetup setup_;
-  size_t frames_ = 0;  // frames to process
+  RunInput input_;
+  size_t frames_ = 0;     // frames to process; 0 = until the source ends
+  size_t delivered_ = 0;  // frames taken from the source
+  std::optional<Timestamp> blackout_return_;
   FrameLog log_;
   FrameImageWriter images_;  // --save-masks / --save-overlays
   std::unique_ptr<System> system_;

@@ -1,0 +1,401 @@
+#!/usr/bin/env python3
+"""The accuracy panel (issue #15): a variant against a baseline on a fixed panel of cells, both
+run in the same invocation, judged by paired differences instead of one clip.
+
+usage: bench/accuracy_panel.py [--variant-flags "..."] [--variant-sed EXPR] [--variant-build DIR]
+                               [--base-flags "..."] [--base-sed EXPR] [--base-build DIR]
+                               [--mode full] [--cells dev,synth] [--jobs 2] [--work DIR]
+                               [--no-spread] [--title TEXT]
+
+A variant is extra `pspslam run` flags, a sed expression applied to every cell's camera config,
+another build folder (a branch built elsewhere), or any mix; so is the baseline (default: this
+checkout's build/, no flags). With no variant option the variant is the baseline itself, which
+measures how far two identical configurations can differ (they should not: runs are deterministic).
+
+Cells (one `pspslam run` each, per variant):
+  dev            ../shared/data/bonn_crowd_dev whole, evaluated whole and also as its person-free
+                 stretch (frames 0-217) and its crowd stretch (218-399), each aligned on its own
+  dev_from_N     the clip started at frame N (N = 30, 90, 150)
+  dev_jpeg80     the colour re-encoded as JPEG quality 80 (build/bench/reencode_colour)
+  dev_depth_F    depth factor F = 4999 and 5001 instead of 5000 (a meaningless change)
+  synth_S        six synthetic sequences (`pspslam synth`: seeds, people, hand-held or loop motion)
+Each cell's spread is how far the baseline moves under a meaningless perturbation of that cell
+(the depth factor one unit up, one more baseline run): a variant that loses by less than the
+spread has not lost. A variant is worth adopting when it wins on most cells and loses by more than
+the spread nowhere.
+
+Per cell and file (trajectory.txt = online, trajectory_refined.txt = final) the ATE RMSE (SE(3),
+`pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
+to the ground truth than the online poses of the same frames. Writes WORK/panel.md and
+WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes (delete WORK, or
+give another, after a rebuild). Needs only the Python standard library.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import re
+import shlex
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PERSON_FREE_END = 218  # bonn_crowd_dev: nobody in view before this frame (shared/README.md)
+DEV_STARTS = (30, 90, 150)
+# (seed, people, trajectory): different rooms (the seed draws the textures and the walkers),
+# crowds and motions.
+SYNTH_CELLS = ((21, 2, "handheld"), (22, 3, "handheld"), (23, 4, "handheld"),
+               (24, 3, "loop"), (25, 2, "loop"), (26, 4, "handheld"))
+SYNTH_FRAMES = 240
+
+
+def log(message):
+    print(f"[{time.strftime('%H:%M:%S')}] {message}", file=sys.stderr, flush=True)
+
+
+def read_list(path):
+    """Lines of a TUM list file: (comment lines, data lines)."""
+    comments, rows = [], []
+    for line in Path(path).read_text().splitlines():
+        (comments if line.startswith("#") or not line.strip() else rows).append(line)
+    return comments, rows
+
+
+def slice_sequence(source, target, first, last):
+    """A TUM folder of colour frames first..last-1 of `source` (by rgb.txt order), with the depth
+    and ground truth of that time span; images are linked, not copied."""
+    target.mkdir(parents=True, exist_ok=True)
+    comments, rgb = read_list(source / "rgb.txt")
+    rgb = rgb[first:last]
+    t0, t1 = float(rgb[0].split()[0]) - 0.05, float(rgb[-1].split()[0]) + 0.05
+    (target / "rgb.txt").write_text("\n".join(comments + rgb) + "\n")
+    for name in ("depth.txt", "groundtruth.txt"):
+        comments, rows = read_list(source / name)
+        rows = [r for r in rows if t0 <= float(r.split()[0]) <= t1]
+        (target / name).write_text("\n".join(comments + rows) + "\n")
+    for folder in ("rgb", "depth"):
+        link = target / folder
+        if not link.exists():
+            link.symlink_to((source / folder).resolve())
+
+
+def stretch_ground_truth(source, target, first, last):
+    """The ground truth of colour frames first..last-1 only: evaluating against it aligns and
+    scores that stretch of a longer run on its own."""
+    _, rgb = read_list(source / "rgb.txt")
+    t0 = float(rgb[first].split()[0]) - 0.02
+    t1 = float(rgb[min(last, len(rgb)) - 1].split()[0]) + 0.02
+    comments, rows = read_list(source / "groundtruth.txt")
+    target.write_text("\n".join(comments + [r for r in rows if t0 <= float(r.split()[0]) <= t1])
+                      + "\n")
+
+
+def set_depth_factor(config_text, factor):
+    text, count = re.subn(r"(depth_factor:\s*)[0-9.eE+-]+", rf"\g<1>{factor}", config_text)
+    if count != 1:
+        raise SystemExit("error: the config has no single 'depth_factor:' key")
+    return text
+
+
+def depth_factor(config_text):
+    return float(re.search(r"depth_factor:\s*([0-9.eE+-]+)", config_text).group(1))
+
+
+class Cell:
+    def __init__(self, name, sequence, config_text, stretches):
+        self.name = name
+        self.sequence = sequence
+        self.config_text = config_text
+        # (evaluation name, ground-truth file) pairs; the first is the whole cell.
+        self.stretches = stretches
+
+
+def prepare_cells(args, work, cli):
+    shared = Path(os.environ.get("PSPSLAM_SHARED", ROOT.parent / "shared"))
+    dev = shared / "data" / "bonn_crowd_dev"
+    cells = []
+    kinds = set(args.cells.split(","))
+    if "dev" in kinds:
+        if not dev.is_dir():
+            raise SystemExit(f"error: {dev} not found (set PSPSLAM_SHARED or --cells synth)")
+        bonn = (ROOT / "config" / "bonn.yaml").read_text()
+        free, crowd = work / "cells" / "dev_person_free_gt.txt", work / "cells" / "dev_crowd_gt.txt"
+        free.parent.mkdir(parents=True, exist_ok=True)
+        stretch_ground_truth(dev, free, 0, PERSON_FREE_END)
+        stretch_ground_truth(dev, crowd, PERSON_FREE_END, 10**9)
+        cells.append(Cell("dev", dev, bonn, [("dev", dev / "groundtruth.txt"),
+                                             ("dev_person_free", free), ("dev_crowd", crowd)]))
+        n = len(read_list(dev / "rgb.txt")[1])
+        for start in DEV_STARTS:
+            folder = work / "cells" / f"dev_from_{start}"
+            slice_sequence(dev, folder, start, n)
+            cells.append(Cell(f"dev_from_{start}", folder, bonn,
+                              [(f"dev_from_{start}", folder / "groundtruth.txt")]))
+        jpeg = work / "cells" / "dev_jpeg80"
+        if not (jpeg / "rgb.txt").exists():
+            tool = Path(args.base_build) / "bench" / "reencode_colour"
+            subprocess.run([str(tool), str(dev), str(jpeg), "80"], check=True,
+                           stdout=subprocess.DEVNULL)
+        cells.append(Cell("dev_jpeg80", jpeg, bonn, [("dev_jpeg80", dev / "groundtruth.txt")]))
+        base_factor = depth_factor(bonn)
+        for delta in (-1, 1):
+            factor = int(base_factor + delta)
+            cells.append(Cell(f"dev_depth_{factor}", dev, set_depth_factor(bonn, factor),
+                              [(f"dev_depth_{factor}", dev / "groundtruth.txt")]))
+    if "synth" in kinds:
+        for seed, people, motion in SYNTH_CELLS:
+            name = f"synth_{seed}_{motion}_{people}p"
+            folder = work / "cells" / name
+            if not (folder / "groundtruth.txt").exists():
+                command = [str(cli), "-q", "synth", "--out", str(folder), "--frames",
+                           str(SYNTH_FRAMES), "--bodies", str(people), "--seed", str(seed),
+                           "--trajectory", motion]
+                if motion == "loop":
+                    command += ["--loop-turns", "1.5"]
+                subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+            cells.append(Cell(name, folder, (folder / "config.yaml").read_text(),
+                              [(name, folder / "groundtruth.txt")]))
+    return cells
+
+
+def apply_sed(text, expression):
+    if not expression:
+        return text
+    return subprocess.run(["sed", "-e", expression], input=text, capture_output=True, text=True,
+                          check=True).stdout
+
+
+def evaluate(cli, ground_truth, estimate):
+    """ATE RMSE (m) and pose count, or (None, 0) when nothing could be associated."""
+    if not estimate.exists() or estimate.stat().st_size == 0:
+        return None, 0
+    result = subprocess.run([str(cli), "-q", "eval", "--gt", str(ground_truth), "--est",
+                             str(estimate), "--json"], capture_output=True, text=True)
+    if result.returncode != 0:
+        return None, 0
+    error = json.loads(result.stdout)["ate"]["error_m"]
+    return error["rmse"], error["count"]
+
+
+def poses_at_stamps(trajectory, stamps_file, target):
+    stamps = {line.split()[0] for line in stamps_file.read_text().splitlines()
+              if line.strip() and not line.startswith("#")}
+    rows = [line for line in trajectory.read_text().splitlines()
+            if line.strip() and not line.startswith("#") and line.split()[0] in stamps]
+    target.write_text("\n".join(rows) + "\n")
+
+
+def run_one(job):
+    """One `pspslam run` of a cell by one variant (or the baseline's spread run); skipped when
+    its stats.json exists. Returns the measurements of every evaluation stretch."""
+    cli, cell, config_text, flags, out, mode = job
+    stats = out / "stats.json"
+    if not stats.exists():
+        out.mkdir(parents=True, exist_ok=True)
+        config = out / "config.yaml"
+        config.write_text(config_text)
+        command = [str(cli), "-q", "run", "--sequence", str(cell.sequence), "--config",
+                   str(config), "--out", str(out / "run"), "--dynamic", mode] + flags
+        started = time.time()
+        result = subprocess.run(command, capture_output=True, text=True)
+        (out / "log.txt").write_text(" ".join(map(shlex.quote, command)) + "\n" + result.stdout +
+                                     result.stderr)
+        if result.returncode not in (0, 3):
+            raise RuntimeError(f"{' '.join(command)} exited {result.returncode}; see {out}/log.txt")
+        run_stats = json.loads((out / "run" / "stats.json").read_text())
+        run_stats["panel_wall_s"] = time.time() - started
+        stats.write_text(json.dumps(run_stats))
+        log(f"{out.relative_to(out.parents[2])}: {run_stats['panel_wall_s']:.0f} s")
+    run_stats = json.loads(stats.read_text())
+    run = out / "run"
+    results = {}
+    for name, ground_truth in cell.stretches:
+        online, tracked = evaluate(cli, ground_truth, run / "trajectory.txt")
+        final, _ = evaluate(cli, ground_truth, run / "trajectory_refined.txt")
+        keyframes, keyframe_count = evaluate(cli, ground_truth, run / "keyframes.txt")
+        online_at_keyframes = None
+        if keyframe_count:
+            subset = out / f"online_at_keyframes_{name}.txt"
+            poses_at_stamps(run / "trajectory.txt", run / "keyframes.txt", subset)
+            online_at_keyframes, _ = evaluate(cli, ground_truth, subset)
+        results[name] = {"online": online, "final": final, "tracked": tracked,
+                         "frames": run_stats["frames"], "keyframes": keyframes,
+                         "online_at_keyframes": online_at_keyframes,
+                         "keyframe_count": keyframe_count}
+    return results
+
+
+def mm(value):
+    return "—" if value is None else f"{value * 1000:.1f}"
+
+
+def summarise(cells, base, variant, spread, args):
+    """Markdown tables and the verdict; returns (markdown, json-able summary)."""
+    names = [name for cell in cells for name, _ in cell.stretches]
+    lines = [f"# Accuracy panel: {args.title}", "",
+             f"mode `{args.mode}`; baseline: build `{args.base_build}`, flags "
+             f"`{args.base_flags or '(none)'}`, sed `{args.base_sed or '(none)'}`; variant: build "
+             f"`{args.variant_build}`, flags `{args.variant_flags or '(none)'}`, sed "
+             f"`{args.variant_sed or '(none)'}`. ATE RMSE in mm (SE(3)); tracked = frames with a "
+             f"pose evaluated / frames processed; KF = keyframes after BA vs the online poses of "
+             f"the same frames (mm); spread = |baseline − baseline with the depth factor one "
+             f"unit up|.", "",
+             "| cell | base online | base final | var online | var final | tracked base/var | "
+             "KF base (BA vs online) | KF var (BA vs online) | spread final | Δ final | verdict |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    summary = {"cells": {}, "title": args.title}
+    wins = losses = bad_losses = 0
+    deltas = {"online": [], "final": []}
+    for name in names:
+        b, v, s = base[name], variant[name], spread.get(name)
+        spread_final = (abs(b["final"] - s["final"]) if s and s["final"] is not None
+                        and b["final"] is not None else None)
+        delta = None
+        verdict = "—"
+        if b["final"] is not None and v["final"] is not None:
+            delta = v["final"] - b["final"]
+            deltas["final"].append(delta)
+            if delta < 0:
+                wins += 1
+                verdict = "win"
+            elif delta > 0:
+                losses += 1
+                verdict = "loss"
+                if spread_final is not None and delta > spread_final:
+                    bad_losses += 1
+                    verdict = "**loss > spread**"
+            else:
+                verdict = "tie"
+        if b["online"] is not None and v["online"] is not None:
+            deltas["online"].append(v["online"] - b["online"])
+        lines.append(
+            f"| {name} | {mm(b['online'])} | {mm(b['final'])} | {mm(v['online'])} | "
+            f"{mm(v['final'])} | {b['tracked']}/{b['frames']} · {v['tracked']}/{v['frames']} | "
+            f"{mm(b['keyframes'])} vs {mm(b['online_at_keyframes'])} | "
+            f"{mm(v['keyframes'])} vs {mm(v['online_at_keyframes'])} | {mm(spread_final)} | "
+            f"{'—' if delta is None else f'{delta * 1000:+.2f}'} | {verdict} |")
+        summary["cells"][name] = {"base": b, "variant": v, "spread": s,
+                                  "spread_final": spread_final, "delta_final": delta}
+
+    def column(runs, key):
+        return [runs[n][key] for n in names if runs[n][key] is not None]
+
+    def stat_line(label, values):
+        if not values:
+            return f"| {label} | — | — | — |"
+        return (f"| {label} | {statistics.median(values) * 1000:.1f} | "
+                f"{min(values) * 1000:.1f} | {max(values) * 1000:.1f} |")
+
+    dev_names = [n for n in names if n.startswith("dev") and n not in
+                 ("dev_person_free", "dev_crowd")]
+    lines += ["", "| over cells | median | min | max |", "|---|---|---|---|"]
+    for label, runs in (("baseline", base), ("variant", variant)):
+        for key in ("online", "final"):
+            lines.append(stat_line(f"{label} {key}, all cells", column(runs, key)))
+            if dev_names:
+                lines.append(stat_line(f"{label} {key}, dev-clip cells (whole clip, starts, "
+                                       "re-encoding, depth factors)",
+                                       [runs[n][key] for n in dev_names
+                                        if runs[n][key] is not None]))
+    kf_better = {label: sum(1 for n in names if runs[n]["keyframes"] is not None and
+                            runs[n]["online_at_keyframes"] is not None and
+                            runs[n]["keyframes"] < runs[n]["online_at_keyframes"])
+                 for label, runs in (("baseline", base), ("variant", variant))}
+    final_not_worse = {label: sum(1 for n in names if runs[n]["final"] is not None and
+                                  runs[n]["online"] is not None and
+                                  runs[n]["final"] <= runs[n]["online"])
+                       for label, runs in (("baseline", base), ("variant", variant))}
+    median_delta = statistics.median(deltas["final"]) if deltas["final"] else None
+    median_online = statistics.median(deltas["online"]) if deltas["online"] else None
+    adopt = wins > len(deltas["final"]) / 2 and bad_losses == 0
+
+    def signed_mm(value):
+        return "—" if value is None else f"{value * 1000:+.1f}"
+
+    lines += ["",
+              f"- paired, final trajectory: variant wins {wins}, loses {losses} "
+              f"({bad_losses} by more than the cell's spread) of {len(deltas['final'])} cells; "
+              f"median Δ {signed_mm(median_delta)} mm (online: median Δ "
+              f"{signed_mm(median_online)} mm)",
+              f"- keyframes after BA closer to the ground truth than the online poses: baseline "
+              f"{kf_better['baseline']}/{len(names)} cells, variant {kf_better['variant']}/"
+              f"{len(names)}",
+              f"- final trajectory not worse than the online one: baseline "
+              f"{final_not_worse['baseline']}/{len(names)}, variant "
+              f"{final_not_worse['variant']}/{len(names)}",
+              f"- verdict: **{'adopt' if adopt else 'do not adopt'}** (adopt = wins on most cells "
+              f"and no loss beyond the cell's spread)"]
+    summary.update({"wins": wins, "losses": losses, "losses_beyond_spread": bad_losses,
+                    "median_delta_final": median_delta, "adopt": adopt,
+                    "keyframes_better_than_online": kf_better,
+                    "final_not_worse_than_online": final_not_worse})
+    return "\n".join(lines) + "\n", summary
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--variant-flags", default="")
+    parser.add_argument("--variant-sed", default="")
+    parser.add_argument("--variant-build", default=None)
+    parser.add_argument("--base-flags", default="")
+    parser.add_argument("--base-sed", default="")
+    parser.add_argument("--base-build", default=str(ROOT / "build"))
+    parser.add_argument("--mode", default="full",
+                        choices=["off", "semantic", "geometry", "full", "exhaustive"])
+    parser.add_argument("--cells", default="dev,synth")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--work", default="/tmp/pspslam_panel")
+    parser.add_argument("--no-spread", action="store_true",
+                        help="skip the baseline's spread runs (no 'loss > spread' verdicts)")
+    parser.add_argument("--title", default="")
+    args = parser.parse_args()
+    args.variant_build = args.variant_build or args.base_build
+    args.title = args.title or (args.variant_flags or args.variant_sed or args.variant_build)
+    if not set(args.cells.split(",")) <= {"dev", "synth"}:
+        parser.error("--cells: a comma-separated list of dev, synth")
+    work = Path(args.work).resolve()
+    clis = {}
+    for label in ("base", "variant"):
+        cli = Path(getattr(args, f"{label}_build")).resolve() / "apps" / "pspslam"
+        if not os.access(cli, os.X_OK):
+            parser.error(f"{cli} is not built (cmake --build BUILD --target pspslam_cli)")
+        clis[label] = cli
+    cells = prepare_cells(args, work, clis["base"])
+
+    jobs, keys = [], []
+    for cell in cells:
+        base_config = apply_sed(cell.config_text, args.base_sed)
+        jobs.append((clis["base"], cell, base_config, shlex.split(args.base_flags),
+                     work / "runs" / cell.name / "base", args.mode))
+        keys.append(("base", cell))
+        jobs.append((clis["variant"], cell, apply_sed(cell.config_text, args.variant_sed),
+                     shlex.split(args.variant_flags), work / "runs" / cell.name / "variant",
+                     args.mode))
+        keys.append(("variant", cell))
+        if not args.no_spread:
+            jittered = set_depth_factor(base_config, int(depth_factor(base_config) + 1))
+            jobs.append((clis["base"], cell, jittered, shlex.split(args.base_flags),
+                         work / "runs" / cell.name / "spread", args.mode))
+            keys.append(("spread", cell))
+    log(f"{len(jobs)} runs of {len(cells)} cells in {work} ({args.jobs} at a time)")
+    started = time.time()
+    results = {"base": {}, "variant": {}, "spread": {}}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        for (label, _), measured in zip(keys, pool.map(run_one, jobs)):
+            results[label].update(measured)
+    markdown, summary = summarise(cells, results["base"], results["variant"], results["spread"],
+                                  args)
+    load = os.getloadavg()
+    markdown += (f"\n_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {len(jobs)} runs in "
+                 f"{(time.time() - started) / 60:.1f} min, {args.jobs} at a time, load "
+                 f"{load[0]:.1f}; command: `{' '.join(map(shlex.quote, sys.argv))}`_\n")
+    (work / "panel.md").write_text(markdown)
+    (work / "panel.json").write_text(json.dumps(summary, indent=1))
+    print(markdown)
+
+
+if __name__ == "__main__":
+    main()

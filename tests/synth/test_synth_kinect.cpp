@@ -267,11 +267,15 @@ TEST(SynthKinect, HandheldMotionHasTheBonnClipsSpeeds) {
     return std::pair{median(rotation), median(translation)};
   };
   const auto [kinect_rotation, kinect_translation] = speeds(kinect_options(0));
+  std::cout << "[ stats    ] kinect hand-held median " << kinect_rotation << " deg/s, "
+            << kinect_translation << " m/s\n";
   EXPECT_NEAR(kinect_rotation, 12.7, 0.15 * 12.7);
   EXPECT_NEAR(kinect_translation, 0.085, 0.15 * 0.085);
   SynthOptions ideal = kinect_options(0);
   ideal.sensor = SynthSensor::kIdeal;
   const auto [ideal_rotation, ideal_translation] = speeds(ideal);
+  std::cout << "[ stats    ] ideal hand-held median " << ideal_rotation << " deg/s, "
+            << ideal_translation << " m/s\n";
   EXPECT_GT(ideal_translation, 1.8 * kinect_translation);
   EXPECT_GT(ideal_rotation, kinect_rotation);
 }

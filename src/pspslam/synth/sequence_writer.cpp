@@ -144,8 +144,10 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
   out << "Synthetic dynamic RGB-D sequence (pspslam synth)\n"
       << "Command: " << describe(scene.options()) << "\n\n"
       << "A closed 7 x 6 x 2.8 m textured room with furniture along the walls, seen by a\n"
-      << "hand-held 640x480 RGB-D camera at 30 Hz (fx = fy = 525, cx = 319.5, cy = 239.5, no\n"
-      << "distortion), while people walk around; one may carry a box.\n\n"
+      << "hand-held 640x480 RGB-D camera at 30 Hz (fx = fy = 525, cx = 319.5, cy = 239.5, "
+      << (scene.system_config().camera.pinhole.has_distortion() ? "distortion in config.yaml"
+                                                                : "no\ndistortion")
+      << "), while people walk around; one may carry a box.\n\n"
       << "rgb/<ts>.png     colour (8-bit BGR)\n"
       << "depth/<ts>.png   depth, 16-bit, 5000 units per metre, 0 = no reading\n"
       << "mask/<ts>.png    ground-truth labels: 0 static, 15 person, 100 carried object;\n"

@@ -5,7 +5,7 @@ run in the same invocation, judged by paired differences instead of one clip.
 usage: bench/accuracy_panel.py [--variant-flags "..."] [--variant-sed EXPR] [--variant-build DIR]
                                [--base-flags "..."] [--base-sed EXPR] [--base-build DIR]
                                [--mode full] [--cells dev,synth] [--jobs 2] [--work DIR]
-                               [--no-spread] [--title TEXT]
+                               [--no-spread] [--title TEXT] [--synth-sensor ideal|kinect]
 
 A variant is extra `pspslam run` flags, a sed expression applied to every cell's camera config,
 another build folder (a branch built elsewhere), or any mix; so is the baseline (default: this
@@ -19,6 +19,10 @@ Cells (one `pspslam run` each, per variant):
   dev_jpeg80     the colour re-encoded as JPEG quality 80 (build/bench/reencode_colour)
   dev_depth_F    depth factor F = 4999 and 5001 instead of 5000 (a meaningless change)
   synth_S        six synthetic sequences (`pspslam synth`: seeds, people, hand-held or loop motion)
+                 rendered with --synth-sensor (default ideal; kinect: a Kinect v1's faults, with a
+                 marker-body ground truth that is moved onto the camera by its body_to_camera.txt;
+                 cells named synth_..._kinect). Kinect cells err like real recordings do; ideal
+                 ones by ~3 mm.
 Each cell's spread is how far the baseline moves under a meaningless perturbation of that cell
 (the depth factor one unit up, one more baseline run): a variant that loses by less than the
 spread has not lost. A variant is worth adopting when it wins on most cells and loses by more than
@@ -105,12 +109,14 @@ def depth_factor(config_text):
 
 
 class Cell:
-    def __init__(self, name, sequence, config_text, stretches):
+    def __init__(self, name, sequence, config_text, stretches, body_to_camera=None):
         self.name = name
         self.sequence = sequence
         self.config_text = config_text
         # (evaluation name, ground-truth file) pairs; the first is the whole cell.
         self.stretches = stretches
+        # `pspslam eval --gt-body-to-camera` file when the ground truth is a marker body.
+        self.body_to_camera = body_to_camera
 
 
 def prepare_cells(args, work, cli):
@@ -148,16 +154,20 @@ def prepare_cells(args, work, cli):
     if "synth" in kinds:
         for seed, people, motion in SYNTH_CELLS:
             name = f"synth_{seed}_{motion}_{people}p"
+            if args.synth_sensor != "ideal":
+                name += f"_{args.synth_sensor}"
             folder = work / "cells" / name
             if not (folder / "groundtruth.txt").exists():
                 command = [str(cli), "-q", "synth", "--out", str(folder), "--frames",
                            str(SYNTH_FRAMES), "--bodies", str(people), "--seed", str(seed),
-                           "--trajectory", motion]
+                           "--trajectory", motion, "--sensor", args.synth_sensor]
                 if motion == "loop":
                     command += ["--loop-turns", "1.5"]
                 subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+            body = folder / "body_to_camera.txt"
             cells.append(Cell(name, folder, (folder / "config.yaml").read_text(),
-                              [(name, folder / "groundtruth.txt")]))
+                              [(name, folder / "groundtruth.txt")],
+                              body if body.exists() else None))
     return cells
 
 
@@ -168,12 +178,14 @@ def apply_sed(text, expression):
                           check=True).stdout
 
 
-def evaluate(cli, ground_truth, estimate):
+def evaluate(cli, ground_truth, estimate, body_to_camera=None):
     """ATE RMSE (m) and pose count, or (None, 0) when nothing could be associated."""
     if not estimate.exists() or estimate.stat().st_size == 0:
         return None, 0
-    result = subprocess.run([str(cli), "-q", "eval", "--gt", str(ground_truth), "--est",
-                             str(estimate), "--json"], capture_output=True, text=True)
+    command = [str(cli), "-q", "eval", "--gt", str(ground_truth), "--est", str(estimate), "--json"]
+    if body_to_camera:
+        command += ["--gt-body-to-camera", str(body_to_camera)]
+    result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         return None, 0
     error = json.loads(result.stdout)["ate"]["error_m"]
@@ -213,14 +225,15 @@ def run_one(job):
     run = out / "run"
     results = {}
     for name, ground_truth in cell.stretches:
-        online, tracked = evaluate(cli, ground_truth, run / "trajectory.txt")
-        final, _ = evaluate(cli, ground_truth, run / "trajectory_refined.txt")
-        keyframes, keyframe_count = evaluate(cli, ground_truth, run / "keyframes.txt")
+        body = cell.body_to_camera
+        online, tracked = evaluate(cli, ground_truth, run / "trajectory.txt", body)
+        final, _ = evaluate(cli, ground_truth, run / "trajectory_refined.txt", body)
+        keyframes, keyframe_count = evaluate(cli, ground_truth, run / "keyframes.txt", body)
         online_at_keyframes = None
         if keyframe_count:
             subset = out / f"online_at_keyframes_{name}.txt"
             poses_at_stamps(run / "trajectory.txt", run / "keyframes.txt", subset)
-            online_at_keyframes, _ = evaluate(cli, ground_truth, subset)
+            online_at_keyframes, _ = evaluate(cli, ground_truth, subset, body)
         results[name] = {"online": online, "final": final, "tracked": tracked,
                          "frames": run_stats["frames"], "keyframes": keyframes,
                          "online_at_keyframes": online_at_keyframes,
@@ -351,6 +364,8 @@ def main():
     parser.add_argument("--no-spread", action="store_true",
                         help="skip the baseline's spread runs (no 'loss > spread' verdicts)")
     parser.add_argument("--title", default="")
+    parser.add_argument("--synth-sensor", default="ideal", choices=["ideal", "kinect"],
+                        help="`pspslam synth --sensor` of the synth cells")
     args = parser.parse_args()
     args.variant_build = args.variant_build or args.base_build
     args.title = args.title or (args.variant_flags or args.variant_sed or args.variant_build)

@@ -2,7 +2,7 @@
 """Splits a trajectory's ATE into what a smoother would remove and what it would not.
 
 usage: bench/trajectory_error_bands.py GROUNDTRUTH ESTIMATE [--window 9] [--stamps FILE]
-                                      [--stretch N]
+                                      [--stretch N] [--gt-body-to-camera FILE]
 
 After the SE(3) alignment of `pspslam eval` (nearest ground-truth pose within 20 ms, positions
 only), the per-frame error e_i is split into its moving average over --window frames
@@ -15,6 +15,9 @@ error comes from; it is a diagnosis, not a metric (the lever arm is fitted to th
 --stamps FILE keeps only the estimate's poses at FILE's timestamps (e.g. a run's keyframes.txt, to
 compare the tracked poses of the keyframe frames with the final keyframe poses); --stretch N also
 prints the ATE RMSE of every N consecutive poses (N = 1: every pose), from the one alignment.
+--gt-body-to-camera FILE (one line 'tx ty tz qx qy qz qw', as `pspslam eval` takes it, e.g. the
+body_to_camera.txt of `pspslam synth --sensor kinect`) first moves the ground truth from its
+marker body onto the camera.
 Needs Debian's python3-numpy (`scripts/install-deps --train` installs it).
 """
 import argparse
@@ -59,8 +62,13 @@ def main():
     parser.add_argument("--window", type=int, default=9)
     parser.add_argument("--stamps", help="evaluate only at the timestamps of this trajectory file")
     parser.add_argument("--stretch", type=int, default=0, help="also print the RMSE per N poses")
+    parser.add_argument("--gt-body-to-camera", help="T_body_camera: tx ty tz qx qy qz qw")
     args = parser.parse_args()
     gt, est = load(args.groundtruth), load(args.estimate)
+    if args.gt_body_to_camera:
+        # Positions only are compared, so only the camera centre moves: p + R_world_body t.
+        body = load(args.gt_body_to_camera)[0]
+        gt[:, 1:4] += np.array([rotation(q) @ body[0:3] for q in gt[:, 4:8]])
     if args.stamps:
         stamps = load(args.stamps)[:, 0]
         est = est[[np.min(np.abs(stamps - t)) < 1e-4 for t in est[:, 0]]]

@@ -315,6 +315,33 @@ TEST(CliRun, BonnCrowdDevSequenceReport) {
   EXPECT_NO_THROW(read_tum_trajectory(out / "trajectory.txt"));
 }
 
+// --sensor kinect --no-fault NAME switches single faults off (named in info.yaml, and without
+// distortion config.yaml has none); --no-fault needs the kinect sensor and a known fault name.
+TEST(CliSynth, KinectSensorFaultSwitches) {
+  const auto dir = testing::make_temp_dir("cli_kinect");
+  Result r =
+      pspslam("synth --out " + (dir / "seq").string() +
+              " --frames 2 --bodies 1 --sensor kinect --no-fault distortion --no-fault marker");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(read_text(dir / "seq" / "info.yaml"),
+                       "faults: depth-noise,holes,sync-offset,rolling-shutter,motion-blur,exposure,"
+                       "handheld-motion\n"));
+  EXPECT_TRUE(contains(read_text(dir / "seq" / "config.yaml"), "distortion: [0, 0, 0, 0, 0]"));
+  EXPECT_TRUE(contains(read_text(dir / "seq" / "body_to_camera.txt"),
+                       "\n0.000000000 0.000000000 "
+                       "0.000000000 0.000000000 "
+                       "0.000000000 0.000000000 "
+                       "1.000000000\n"));
+  r = pspslam("synth --out " + (dir / "b").string() + " --frames 2 --no-fault holes");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "error: synth: flag --no-fault needs --sensor kinect\n");
+  r = pspslam("synth --out " + (dir / "c").string() +
+              " --frames 2 --sensor kinect --no-fault blur");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: pspslam synth: --no-fault: blur not in {depth-noise,"))
+      << r.output;
+}
+
 // --keyframe-ratio reaches the keyframe policy: on the same sequence, ORB-SLAM2's sparser 0.5
 // makes fewer keyframes than 0.95; out-of-range values are errors.
 TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {

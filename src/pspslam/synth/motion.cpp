@@ -33,9 +33,10 @@ Eigen::Matrix3d rot_y(double angle) {
 }  // namespace
 
 CameraPath::CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room,
-                       double loop_turns)
+                       double loop_turns, MotionProfile profile)
     : loop_(loop),
       loop_turns_(loop_turns),
+      profile_(profile),
       duration_s_(std::max(duration_s, 1e-3)),
       centre_(room.floor_centre()) {
   const uint64_t camera_seed = mix_hash(seed, 0xCA3E7Au);
@@ -59,20 +60,27 @@ Pose CameraPath::T_world_camera(double t) const {
   } else {
     // Slow incommensurate sinusoids: smooth, never exactly repeating, speeds <= 0.35 m/s and
     // yaw rates <= 35 deg/s, like a person filming while walking around slowly.
-    position << centre_.x() + 0.55 * std::sin(0.45 * t + ph[0]) + 0.08 * std::sin(1.3 * t + ph[1]),
-        centre_.y() + 0.4 * std::sin(0.37 * t + ph[2]), 1.45 + 0.06 * std::sin(0.8 * t + ph[3]);
-    yaw = yaw0_ + 1.1 * std::sin(0.35 * t + ph[4]) + 0.25 * std::sin(0.9 * t + ph[5]);
-    pitch = -0.15 + 0.08 * std::sin(0.6 * t + ph[6]);
-    roll = 0.04 * std::sin(0.5 * t + ph[7]);
+    // Scaled term by term in the original order: a profile of 1.0 leaves every rounding, so
+    // the ideal path keeps its bytes.
+    const double p = profile_.translation, r = profile_.rotation;
+    position << centre_.x() + p * 0.55 * std::sin(0.45 * t + ph[0]) +
+                    p * 0.08 * std::sin(1.3 * t + ph[1]),
+        centre_.y() + p * 0.4 * std::sin(0.37 * t + ph[2]),
+        1.45 + p * 0.06 * std::sin(0.8 * t + ph[3]);
+    yaw = yaw0_ + r * 1.1 * std::sin(0.35 * t + ph[4]) + r * 0.25 * std::sin(0.9 * t + ph[5]);
+    pitch = -0.15 + r * 0.08 * std::sin(0.6 * t + ph[6]);
+    roll = r * 0.04 * std::sin(0.5 * t + ph[7]);
   }
   // Hand shake: small fast rotations (~0.3 deg) and translations (~2 mm).
-  const Eigen::Vector3d shake_rotation(
+  const Eigen::Vector3d shake_rotation_unit(
       0.004 * std::sin(9.1 * t + ph[8]) + 0.002 * std::sin(15.3 * t + ph[9]),
       0.004 * std::sin(8.3 * t + ph[10]) + 0.002 * std::sin(14.1 * t + ph[11]),
       0.003 * std::sin(7.7 * t + ph[12]));
-  const Eigen::Vector3d shake_translation(0.002 * std::sin(10.3 * t + ph[13]),
-                                          0.002 * std::sin(11.9 * t + ph[14]),
-                                          0.002 * std::sin(9.7 * t + ph[15]));
+  const Eigen::Vector3d shake_translation_unit(0.002 * std::sin(10.3 * t + ph[13]),
+                                               0.002 * std::sin(11.9 * t + ph[14]),
+                                               0.002 * std::sin(9.7 * t + ph[15]));
+  const Eigen::Vector3d shake_rotation = profile_.shake * shake_rotation_unit;
+  const Eigen::Vector3d shake_translation = profile_.shake * shake_translation_unit;
   Pose pose = Pose::Identity();
   const double shake_angle = shake_rotation.norm();
   const Eigen::Matrix3d shake =

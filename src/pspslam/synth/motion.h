@@ -20,10 +20,18 @@ struct RoomLayout {
 // Loop: walks an ellipse (~5.7 m long) looking outwards and ends `loop_turns` turns after its
 // start (default 1.08: 8% of a turn past it), so the last frames revisit the first viewpoint
 // (for loop-closure tests; more turns = a longer revisit, e.g. for covisibility consistency).
+// Scales of the hand-held path's slow rotation, slow translation and hand shake (1, 1, 1: the
+// path as it always was).
+struct MotionProfile {
+  double rotation = 1.0;
+  double translation = 1.0;
+  double shake = 1.0;
+};
+
 class CameraPath {
  public:
   CameraPath(bool loop, uint64_t seed, double duration_s, const RoomLayout& room,
-             double loop_turns = 1.08);
+             double loop_turns = 1.08, MotionProfile profile = {});
   Pose T_world_camera(double t) const;
   // Mean viewing direction (world yaw) of the hand-held camera: where people should walk.
   double mean_heading() const { return yaw0_; }
@@ -31,6 +39,7 @@ class CameraPath {
  private:
   bool loop_;
   double loop_turns_;
+  MotionProfile profile_;
   double duration_s_;
   Eigen::Vector2d centre_;
   double phases_[16];

@@ -9,6 +9,7 @@
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
+#include "pspslam/synth/kinect.h"
 
 namespace pspslam {
 
@@ -22,6 +23,13 @@ inline constexpr uint8_t kSynthLabelCarried = 100;  // a box (static class) carr
 inline constexpr int kMaxBodies = 200;
 
 enum class SynthTrajectory { kHandheld, kLoop };
+
+// ideal: the renderer as it was before issue #15 item 2 (registered, synchronised, global
+// shutter, no distortion; depth noise per --depth-noise). kinect: a hand-held structured-light
+// camera with the faults of SynthOptions::faults (synth/kinect.h).
+enum class SynthSensor { kIdeal, kKinect };
+SynthSensor parse_synth_sensor(const std::string& name);
+std::string to_string(SynthSensor sensor);
 
 // "handheld" | "loop"; anything else throws pspslam::Error naming the flag.
 SynthTrajectory parse_synth_trajectory(const std::string& name);
@@ -37,7 +45,9 @@ struct SynthOptions {
   // Kinect-like sensor: noise growing with depth squared plus holes (range limits, grazing
   // angles, discontinuity shadows, dropouts). Off: depth_sensor is the exact depth.
   bool depth_noise = true;
-  int threads = 0;  // worker threads for rendering / writing; 0 = all hardware threads
+  SynthSensor sensor = SynthSensor::kIdeal;
+  synth::KinectFaults faults;  // used with sensor == kKinect only (depth_noise is then ignored)
+  int threads = 0;             // worker threads for rendering / writing; 0 = all hardware threads
 
   // Throws pspslam::Error naming the offending CLI flag (--frames, --bodies, ...).
   void validate() const;
@@ -48,7 +58,9 @@ struct SynthFrame {
   Timestamp timestamp = 0.0;
   Pose T_world_camera = Pose::Identity();  // exact ground truth, camera-to-world
   cv::Mat bgr;                             // CV_8UC3
-  cv::Mat depth;         // CV_32F metres, exact z-depth of every pixel (the room is closed)
+  // CV_32F metres, exact z-depth of every pixel (the room is closed); kinect: at the depth
+  // camera's instant (t + depth_time_offset), through the same lens distortion as colour.
+  cv::Mat depth;
   cv::Mat depth_sensor;  // CV_32F metres, exactly what depth/<ts>.png holds (0 = no reading)
   cv::Mat labels;        // CV_8U, kSynthLabel* values
   cv::Mat surface_ids;   // CV_16U, 1 + which box face each pixel shows: for visibility tests
@@ -73,7 +85,18 @@ class SyntheticScene {
   size_t frame_count() const;
   Timestamp timestamp(size_t index) const;  // 1000000 + index / 30 s
   Pose camera_pose(size_t index) const;     // T_world_camera
-  Trajectory ground_truth() const;          // all frames
+  Trajectory ground_truth() const;          // all frames, camera poses
+  // T_world_camera at `seconds` after the first frame (any instant, e.g. between frames).
+  Pose camera_pose_at(double seconds) const;
+  // Depth capture instant minus colour capture instant of a frame (0 unless kinect sync-offset).
+  double depth_time_offset(size_t index) const;
+  // The motion-capture body whose pose groundtruth.txt holds: T_body_camera maps camera points
+  // into the body frame (identity unless kinect marker); ground_truth_pose = camera * inverse.
+  Pose T_body_camera() const;
+  Pose ground_truth_pose(size_t index) const;
+  // config.yaml of the sequence: synthetic_system_config() plus the lens distortion when the
+  // kinect distortion fault is on.
+  SystemConfig system_config() const;
 
  private:
   struct Impl;

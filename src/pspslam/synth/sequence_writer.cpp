@@ -45,12 +45,23 @@ void close_text(std::ofstream& out, const fs::path& file) {
   if (!out) throw Error("synth: failed writing " + file.string());
 }
 
+// " --sensor kinect --no-fault ..." for a kinect sequence; "" for the ideal one, whose files
+// keep the bytes they had before the kinect sensor existed.
+std::string kinect_flags(const SynthOptions& options) {
+  if (options.sensor != SynthSensor::kKinect) return "";
+  std::string flags = " --sensor kinect";
+  for (const std::string& name : synth::KinectFaults::names()) {
+    if (!options.faults.is_on(name)) flags += " --no-fault " + name;
+  }
+  return flags;
+}
+
 std::string describe(const SynthOptions& options) {
   return "pspslam synth --frames " + std::to_string(options.frames) + " --bodies " +
          std::to_string(options.bodies) + " --seed " + std::to_string(options.seed) +
          " --trajectory " + to_string(options.trajectory) + " --depth-noise " +
          (options.depth_noise ? "on" : "off") + " --carried-objects " +
-         std::to_string(options.carried_objects);
+         std::to_string(options.carried_objects) + kinect_flags(options);
 }
 
 void write_frame_list(const fs::path& dir, const std::string& list_name, const std::string& folder,
@@ -68,11 +79,14 @@ void write_frame_list(const fs::path& dir, const std::string& list_name, const s
 void write_ground_truth(const fs::path& dir, const SyntheticScene& scene) {
   const fs::path file = dir / "groundtruth.txt";
   std::ofstream out = open_text(file);
-  out << "# ground truth trajectory (camera-to-world, exact)\n# file: '"
+  const bool marker = !scene.T_body_camera().isApprox(Pose::Identity(), 0.0);
+  out << (marker ? "# ground truth trajectory (motion-capture marker body-to-world, exact; "
+                   "body_to_camera.txt moves it onto the camera)\n# file: '"
+                 : "# ground truth trajectory (camera-to-world, exact)\n# file: '")
       << describe(scene.options()) << "'\n# timestamp tx ty tz qx qy qz qw\n";
   char line[256];
   for (size_t i = 0; i < scene.frame_count(); ++i) {
-    const Pose pose = scene.camera_pose(i);
+    const Pose pose = scene.ground_truth_pose(i);
     Eigen::Quaterniond q(pose.linear());
     if (q.w() < 0) q.coeffs() = -q.coeffs();  // one canonical sign: byte-identical files
     const Eigen::Vector3d t = pose.translation();
@@ -81,6 +95,23 @@ void write_ground_truth(const fs::path& dir, const SyntheticScene& scene) {
                   q.z(), q.w());
     out << line;
   }
+  close_text(out, file);
+}
+
+// T_body_camera as `pspslam eval --gt-body-to-camera` reads it (tx ty tz qx qy qz qw).
+void write_body_to_camera(const fs::path& dir, const SyntheticScene& scene) {
+  const fs::path file = dir / "body_to_camera.txt";
+  std::ofstream out = open_text(file);
+  const Pose T = scene.T_body_camera();
+  Eigen::Quaterniond q(T.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  char line[256];
+  std::snprintf(line, sizeof(line), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", T.translation().x(),
+                T.translation().y(), T.translation().z(), q.x(), q.y(), q.z(), q.w());
+  out << "# T_body_camera: camera points into the marker body of groundtruth.txt\n"
+      << "# use: pspslam eval --gt groundtruth.txt --gt-body-to-camera body_to_camera.txt\n"
+      << "# tx ty tz qx qy qz qw\n"
+      << line;
   close_text(out, file);
 }
 
@@ -95,8 +126,12 @@ void write_info(const fs::path& dir, const SyntheticScene& scene) {
       << "bodies: " << o.bodies << "\n"
       << "carried_objects: " << o.carried_objects << "\n"
       << "trajectory: " << to_string(o.trajectory) << "\n"
-      << "depth_noise: " << (o.depth_noise ? "on" : "off") << "\n"
-      << "labels:  # mask/*.png values; label != 0 is the ground-truth dynamic mask\n"
+      << "depth_noise: " << (o.depth_noise ? "on" : "off") << "\n";
+  if (o.sensor == SynthSensor::kKinect) {
+    out << "sensor: kinect\n"
+        << "faults: " << o.faults.describe() << "\n";
+  }
+  out << "labels:  # mask/*.png values; label != 0 is the ground-truth dynamic mask\n"
       << "  static: " << int{kSynthLabelStatic} << "\n"
       << "  person: " << int{kSynthLabelPerson} << "\n"
       << "  carried_object: " << int{kSynthLabelCarried} << "\n";
@@ -109,8 +144,10 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
   out << "Synthetic dynamic RGB-D sequence (pspslam synth)\n"
       << "Command: " << describe(scene.options()) << "\n\n"
       << "A closed 7 x 6 x 2.8 m textured room with furniture along the walls, seen by a\n"
-      << "hand-held 640x480 RGB-D camera at 30 Hz (fx = fy = 525, cx = 319.5, cy = 239.5, no\n"
-      << "distortion), while people walk around; one may carry a box.\n\n"
+      << "hand-held 640x480 RGB-D camera at 30 Hz (fx = fy = 525, cx = 319.5, cy = 239.5, "
+      << (scene.system_config().camera.pinhole.has_distortion() ? "distortion in config.yaml"
+                                                                : "no\ndistortion")
+      << "), while people walk around; one may carry a box.\n\n"
       << "rgb/<ts>.png     colour (8-bit BGR)\n"
       << "depth/<ts>.png   depth, 16-bit, 5000 units per metre, 0 = no reading\n"
       << "mask/<ts>.png    ground-truth labels: 0 static, 15 person, 100 carried object;\n"
@@ -119,6 +156,14 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
       << "groundtruth.txt  timestamp tx ty tz qx qy qz qw, camera-to-world, exact\n"
       << "config.yaml      camera config for 'pspslam run --sequence <this folder>'\n"
       << "info.yaml        generator parameters\n";
+  if (scene.options().sensor == SynthSensor::kKinect) {
+    out << "\nSensor: kinect, faults " << scene.options().faults.describe() << ":\n"
+        << "depth noise 1.425e-3 z^2 m quantised to 1/8 px of disparity, holes (projector\n"
+        << "shadow, dark and grazing surfaces), depth captured up to +-16 ms off colour, a 30 ms\n"
+        << "rolling shutter, motion blur, exposure changes, lens distortion (config.yaml), the\n"
+        << "Bonn clip's hand-held speeds, and ground truth of a marker body:\n"
+        << "body_to_camera.txt  T_body_camera for 'pspslam eval --gt-body-to-camera'\n";
+  }
   close_text(out, file);
 }
 
@@ -209,7 +254,8 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   write_frame_list(dir, "mask.txt", "mask",
                    "ground-truth labels (0 static, 15 person, 100 carried object)", scene);
   write_ground_truth(dir, scene);
-  save_config(dir / "config.yaml", synthetic_system_config());
+  save_config(dir / "config.yaml", scene.system_config());
+  if (scene.options().sensor == SynthSensor::kKinect) write_body_to_camera(dir, scene);
   write_info(dir, scene);
   write_readme(dir, scene);
 }

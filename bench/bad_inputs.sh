@@ -111,6 +111,9 @@ row "--export-dense below a regular file" 2 -- $R --sequence seq --export-dense 
 row "--save-masks below a regular file" 2 -- $R --sequence seq --save-masks a_file/masks
 row "--save-overlays is a regular file" 2 -- $R --sequence seq --save-overlays a_file
 row "eval --title without its value" 2 -- "$cli" eval --gt seq/groundtruth.txt --est good/trajectory.txt --title
+row "--camera webcam (unknown driver)" 2 -- "$cli" run --camera webcam --out out
+row "--camera freenect with no Kinect attached" 2 -- "$cli" run --camera freenect --out out
+row "record --camera freenect:abc" 2 -- "$cli" record --camera freenect:abc --out rec
 row "--log-level chatty" 2 -- "$cli" --log-level chatty run --sequence seq
 row "sequence folder missing" 2 -- $R --sequence nowhere
 row "no rgb.txt / depth.txt" 2 -- $R --sequence no_lists

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
+#include <iostream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,8 @@ class MapFileTest : public ::testing::Test {
     keyframes_saved_ = keyframes;
     points_saved_ = points;
     // The live map, to compare the loaded one with.
+    for (const auto& point : system.map().map_points())
+      live_first_keyframe_[point->id()] = point->first_keyframe_id;
     for (const auto& keyframe : system.map().keyframes()) {
       live_keyframes_.push_back(
           {keyframe->id(), keyframe->T_camera_world(), keyframe->size(),
@@ -117,6 +121,7 @@ class MapFileTest : public ::testing::Test {
   static inline size_t keyframes_saved_ = 0;
   static inline size_t points_saved_ = 0;
   static inline std::vector<LiveKeyFrame> live_keyframes_;
+  static inline std::map<std::uint64_t, std::uint64_t> live_first_keyframe_;  // by point id
 };
 
 TEST_F(MapFileTest, LoadRebuildsTheSameKeyframesPointsAndGraph) {
@@ -137,6 +142,15 @@ TEST_F(MapFileTest, LoadRebuildsTheSameKeyframesPointsAndGraph) {
   EXPECT_GT(map.next_keyframe_id(), keyframes.back()->id());
   std::uint64_t max_point_id = 0;
   for (const auto& point : map.map_points()) max_point_id = std::max(max_point_id, point->id());
+  // Each point keeps the id of the keyframe that made it, even one culled before saving.
+  size_t first_keyframe_culled = 0;
+  for (const auto& point : map.map_points()) {
+    ASSERT_TRUE(live_first_keyframe_.contains(point->id())) << "point " << point->id();
+    EXPECT_EQ(point->first_keyframe_id, live_first_keyframe_.at(point->id()))
+        << "point " << point->id();
+    if (!map.keyframe(point->first_keyframe_id)) ++first_keyframe_culled;
+  }
+  std::cout << "points whose first keyframe was culled: " << first_keyframe_culled << "\n";
   EXPECT_GT(map.next_map_point_id(), max_point_id);
   for (size_t k = 0; k < keyframes.size(); ++k) {
     const LiveKeyFrame& live = live_keyframes_[k];

@@ -388,8 +388,9 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
     const std::shared_ptr<KeyFrame>& reference_keyframe =
         keyframes[reference != keyframe_index.end() ? reference->second : 0];
     auto point = std::make_shared<MapPoint>(record.id, record.position, reference_keyframe);
-    const auto first = keyframe_index.find(record.first_keyframe);
-    point->first_keyframe_id = first != keyframe_index.end() ? keyframes[first->second]->id() : 0;
+    // Kept as saved even when that keyframe was culled before saving: only its order against
+    // newer keyframes matters (recent-point culling), and the file must save back unchanged.
+    point->first_keyframe_id = record.first_keyframe;
     points.push_back(point);
   }
   MapFileSummary summary;

@@ -53,6 +53,7 @@ GlobalBaResult solve_global_bundle_adjustment(const Map& map, const GlobalBaOpti
   ba.robust_iterations = options.iterations;
   ba.refine_iterations = 0;  // ORB-SLAM2's global BA keeps every observation (no second stage)
   ba.max_seconds = options.max_seconds;
+  ba.depth_noise = options.depth_noise;
   ba.should_stop = options.should_stop;
   const RgbdCamera& camera = any_keyframe->camera();
   const BaResult solved = solve_bundle_adjustment(problem, camera.pinhole, camera.bf, ba);

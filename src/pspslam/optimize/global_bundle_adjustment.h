@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "pspslam/core/types.h"
+#include "pspslam/optimize/depth_noise_model.h"
 
 namespace pspslam {
 
@@ -26,6 +27,12 @@ struct GlobalBaOptions {
   int iterations = 10;  // ORB-SLAM2: 10 Levenberg-Marquardt iterations with the Huber kernel
   double max_seconds = 120.0;
   std::function<bool()> should_stop;
+  // How the depth row is weighed: must be the local BA's model (System passes the camera's).
+  // With the tracker and local BA on the sensor model but this on ORB-SLAM2's u_r row (15x
+  // looser), the global BA undid local BA's depth constraint: on the synthetic 1.5-turn loop two
+  // weakly connected keyframes (2 covisible keyframes each, 86-100 shared points) slid to 23-25 mm
+  // off (docs/benchmarks.md, #15 item 5). Default as BaOptions: the u_r row.
+  DepthNoiseModel depth_noise{.scale = 20.0};
 };
 
 struct GlobalBaResult {

@@ -219,10 +219,16 @@ System::System(const SystemConfig& config, SystemOptions options)
   synchronous_local_mapping_ = options.synchronous_local_mapping;
   record_keypoint_fates_ = options.record_keypoint_fates;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
+    LoopClosingOptions loop_options;
+    // The global BA weighs depth as local BA does; otherwise it moves weakly connected keyframes
+    // away from where local BA's depth constraint held them (#15 item 5).
+    if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
+      loop_options.global_ba.depth_noise = {.enabled = true,
+                                            .scale = config.camera.depth_noise_scale};
     // The callback runs on a loop closing thread with Map::update_mutex() held, so the tracker
     // (which holds it for a whole frame) is never re-anchored in the middle of a frame.
     loop_closing_ = std::make_unique<LoopClosing>(map_, place_, mapping_->local_mapping(),
-                                                  LoopClosingOptions{}, [this] {
+                                                  loop_options, [this] {
                                                     tracker_->on_map_corrected();
                                                     ++map_corrections_;
                                                   });

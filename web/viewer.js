@@ -57,7 +57,7 @@ function mapPoints(map) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.Float32BufferAttribute(map.positions, 3));
   geometry.setAttribute('color', new THREE.Uint8BufferAttribute(map.colors, 3, true));
-  return new THREE.Points(geometry, new THREE.PointsMaterial({ size: 0.02, vertexColors: true }));
+  return new THREE.Points(geometry, new THREE.PointsMaterial({ size: 0.03, vertexColors: true }));
 }
 
 function drawScene(trajectory, map, truth) {
@@ -80,17 +80,15 @@ function drawScene(trajectory, map, truth) {
   if (path.length) world.add(lineThrough(path, 0xe8a33d));
   if (truth.positions.length)
     world.add(lineThrough(truth.positions.map((p) => new THREE.Vector3(...p)), 0x3db4e8));
-  world.add(frusta(trajectory.keyframes, 0.08));
+  world.add(frusta(trajectory.keyframes, 0.05));
   world.add(new THREE.AxesHelper(0.3));
 
-  // Frame the map (else the trajectory): look at its centre from a distance that fits it.
-  const framed = [];
-  for (let i = 0; i < map.positions.length; i += 3) framed.push(new THREE.Vector3(...map.positions.slice(i, i + 3)));
-  const box = new THREE.Box3().setFromPoints(framed.length ? framed : path.length ? path : [new THREE.Vector3()]);
+  // Frame the trajectory with room around it: the map's stray far points would shrink the view.
+  const box = new THREE.Box3().setFromPoints(path.length ? path : [new THREE.Vector3()]);
   world.updateMatrixWorld();
   box.applyMatrix4(world.matrixWorld);
   const centre = box.getCenter(new THREE.Vector3());
-  const size = Math.max(box.getSize(new THREE.Vector3()).length(), 1);
+  const size = Math.max(box.getSize(new THREE.Vector3()).length(), 1.5);
   const camera = new THREE.PerspectiveCamera(50, container.clientWidth / container.clientHeight,
                                              0.01, 1000);
   camera.position.copy(centre).add(new THREE.Vector3(size * 0.3, size * 0.45, size * 0.6));

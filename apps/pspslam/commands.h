@@ -24,6 +24,7 @@ Command add_record_command(CLI::App& root);
 Command add_eval_command(CLI::App& root);
 Command add_synth_command(CLI::App& root);
 Command add_segment_command(CLI::App& root);
+Command add_view_command(CLI::App& root);
 Command add_vocab_train_command(CLI::App& vocab);
 Command add_vocab_info_command(CLI::App& vocab);
 

@@ -106,9 +106,9 @@ int main(int argc, char** argv) {
   root.add_flag("--quiet,-q", quiet, "only warnings and errors on stderr, no progress bar");
 
   std::vector<pspslam::cli::Command> commands = {
-      pspslam::cli::add_run_command(root), pspslam::cli::add_eval_command(root),
-      pspslam::cli::add_synth_command(root), pspslam::cli::add_segment_command(root),
-      pspslam::cli::add_record_command(root)};
+      pspslam::cli::add_run_command(root),    pspslam::cli::add_eval_command(root),
+      pspslam::cli::add_synth_command(root),  pspslam::cli::add_segment_command(root),
+      pspslam::cli::add_record_command(root), pspslam::cli::add_view_command(root)};
   CLI::App* vocab = root.add_subcommand("vocab", "train / inspect the bag-of-words vocabulary");
   vocab->require_subcommand(1);
   commands.push_back(pspslam::cli::add_vocab_train_command(*vocab));

@@ -21,6 +21,22 @@ grep -q "dynamic:      full (model $work/moved/share/pspslam/models/pspnet/pspne
   "$work/run.log" || { echo "FAIL: the default model is not the installed one"; cat "$work/run.log"; exit 1; }
 grep -q "loop closing: on" "$work/run.log" ||
   { echo "FAIL: the installed vocabulary was not found (loop closing off)"; cat "$work/run.log"; exit 1; }
+# The installed viewer serves its page and three.js from share/pspslam/web (plain bash /dev/tcp:
+# no HTTP client is among the dependencies).
+"$cli" view "$work/out" --viewer 0 > "$work/view.log" 2>&1 &
+view_pid=$!
+for _ in $(seq 600); do grep -q 'viewer: http' "$work/view.log" && break; sleep 0.1; done
+port=$(sed -n 's|^viewer: http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$work/view.log")
+for asset in / /vendor/three/build/three.module.js /vendor/three/examples/jsm/controls/OrbitControls.js; do
+  exec 3<> "/dev/tcp/127.0.0.1/$port"
+  printf 'GET %s HTTP/1.0\r\n\r\n' "$asset" >&3
+  status=$(head -n 1 <&3)
+  exec 3>&-
+  [[ $status == *" 200 "* ]] ||
+    { echo "FAIL: installed viewer: $asset: $status"; cat "$work/view.log"; kill -INT $view_pid; exit 1; }
+done
+kill -INT $view_pid
+wait $view_pid || { echo "FAIL: the viewer did not stop cleanly"; cat "$work/view.log"; exit 1; }
 if grep -rq "$source" "$work/moved/lib/cmake"; then
   echo "FAIL: the package config points into the source tree"; exit 1
 fi

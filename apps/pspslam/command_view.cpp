@@ -1,0 +1,317 @@
+// `pspslam view`: shows a finished run in the browser. A small HTTP server (cpp-httplib) serves
+// the page in web/ and JSON built once from the run's output files, so nothing of SLAM runs here.
+#include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "commands.h"
+#include "pspslam/core/error.h"
+#include "pspslam/core/interrupt.h"
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/eval/ate.h"
+#include "pspslam/io/point_cloud_ply.h"
+#include "pspslam/io/trajectory_io.h"
+
+// Last: through <resolv.h> it defines a macro `_res`, which Eigen uses as a parameter name.
+#include <httplib.h>
+
+namespace pspslam::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ViewOptions {
+  std::string run_dir;
+  std::string viewer = "8080";
+  std::string gt_file;
+};
+
+struct Endpoint {
+  std::string host = "127.0.0.1";
+  int port = 8080;
+};
+
+// "[HOST:]PORT"; the last ':' splits, so "[::1]:8080" style IPv6 needs the brackets removed.
+Endpoint parse_endpoint(const std::string& text) {
+  Endpoint endpoint;
+  std::string port_text = text;
+  if (const size_t colon = text.rfind(':'); colon != std::string::npos) {
+    endpoint.host = text.substr(0, colon);
+    if (endpoint.host.size() >= 2 && endpoint.host.front() == '[' && endpoint.host.back() == ']')
+      endpoint.host = endpoint.host.substr(1, endpoint.host.size() - 2);
+    port_text = text.substr(colon + 1);
+  }
+  const bool digits = !port_text.empty() && port_text.size() <= 5 &&
+                      port_text.find_first_not_of("0123456789") == std::string::npos;
+  if (endpoint.host.empty() || !digits || std::stoi(port_text) > 65535) {
+    throw Error("--viewer " + text + ": expected [HOST:]PORT with PORT 0-65535 (0: any free port)");
+  }
+  endpoint.port = std::stoi(port_text);
+  return endpoint;
+}
+
+bool is_loopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+nlohmann::json poses_json(const Trajectory& trajectory) {
+  nlohmann::json poses = nlohmann::json::array();
+  for (const StampedPose& pose : trajectory) {
+    const Eigen::Vector3d p = pose.T_world_camera.translation();
+    const Eigen::Quaterniond q(pose.T_world_camera.rotation());
+    poses.push_back(
+        {{"t", pose.timestamp}, {"p", {p.x(), p.y(), p.z()}}, {"q", {q.x(), q.y(), q.z(), q.w()}}});
+  }
+  return poses;
+}
+
+// A trajectory the run may not have written (an interrupted run has no keyframes.txt): empty.
+Trajectory read_if_present(const fs::path& file) {
+  return fs::is_regular_file(file) ? read_tum_trajectory(file) : Trajectory{};
+}
+
+nlohmann::json read_stats(const fs::path& run_dir) {
+  const fs::path file = run_dir / "stats.json";
+  if (!fs::is_regular_file(file)) return nlohmann::json::object();
+  try {
+    std::ifstream stream(file);
+    return nlohmann::json::parse(stream);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file.string() + ": not valid JSON: " + e.what());
+  }
+}
+
+nlohmann::json map_json(const fs::path& run_dir) {
+  nlohmann::json map = {{"positions", nlohmann::json::array()},
+                        {"colors", nlohmann::json::array()}};
+  const fs::path file = run_dir / "map.ply";
+  if (!fs::is_regular_file(file)) return map;
+  // Flat arrays: they go straight into a three.js BufferAttribute.
+  for (const ColoredPoint& point : read_point_cloud_ply(file)) {
+    for (int i = 0; i < 3; ++i) map["positions"].push_back(point.position[i]);
+    map["colors"].push_back(point.red);
+    map["colors"].push_back(point.green);
+    map["colors"].push_back(point.blue);
+  }
+  return map;
+}
+
+// The ground truth moved into the estimate's frame (the inverse of the ATE alignment, which maps
+// the estimate onto the ground truth), so the map and the estimate keep their own coordinates.
+nlohmann::json ground_truth_json(const fs::path& gt_file, const Trajectory& estimate) {
+  nlohmann::json result = {{"file", gt_file.string()}, {"positions", nlohmann::json::array()}};
+  if (gt_file.empty() || estimate.empty()) return result;
+  const AteResult ate = compute_ate(read_tum_trajectory(gt_file), estimate);
+  const Alignment& a = ate.alignment;
+  for (const Eigen::Vector3d& g : ate.gt_all) {
+    const Eigen::Vector3d p = a.rotation.transpose() * (g - a.translation) / a.scale;
+    result["positions"].push_back({p.x(), p.y(), p.z()});
+  }
+  result["ate_rmse"] = ate.error.rmse;
+  return result;
+}
+
+// --gt, else the sequence's own groundtruth.txt named by stats.json, else none.
+fs::path ground_truth_file(const ViewOptions& options, const nlohmann::json& stats) {
+  if (!options.gt_file.empty()) {
+    if (!fs::is_regular_file(options.gt_file)) throw Error(options.gt_file + ": no such file");
+    return options.gt_file;
+  }
+  if (stats.contains("sequence") && stats["sequence"].is_string()) {
+    const fs::path candidate = fs::path(stats["sequence"].get<std::string>()) / "groundtruth.txt";
+    std::error_code failure;
+    if (fs::is_regular_file(candidate, failure)) return candidate;
+  }
+  return {};
+}
+
+// Everything the API serves, built once: the run is finished, so the answers never change and
+// the server threads only read these strings.
+struct RunData {
+  std::string trajectory, stats, map, ground_truth;
+  size_t poses = 0;
+};
+
+RunData load_run(const ViewOptions& options) {
+  const fs::path run_dir = options.run_dir;
+  if (!fs::is_regular_file(run_dir / "trajectory.txt")) {
+    throw Error(options.run_dir +
+                ": not a run folder (no trajectory.txt; make one with 'pspslam "
+                "run --out " +
+                options.run_dir + "')");
+  }
+  const Trajectory online = read_tum_trajectory(run_dir / "trajectory.txt");
+  const Trajectory refined = read_if_present(run_dir / "trajectory_refined.txt");
+  const nlohmann::json stats = read_stats(run_dir);
+  RunData data;
+  data.poses = online.size();
+  data.trajectory =
+      nlohmann::json{{"online", poses_json(online)},
+                     {"refined", poses_json(refined)},
+                     {"keyframes", poses_json(read_if_present(run_dir / "keyframes.txt"))}}
+          .dump();
+  data.stats = stats.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  data.map = map_json(run_dir).dump();
+  const fs::path gt_file = ground_truth_file(options, stats);
+  try {
+    data.ground_truth = ground_truth_json(gt_file, refined.empty() ? online : refined).dump();
+  } catch (const Error& e) {
+    // Too few associated poses should not keep the rest of the run from being shown.
+    spdlog::warn("ground truth not shown: {}", e.what());
+    data.ground_truth = ground_truth_json({}, {}).dump();
+  }
+  return data;
+}
+
+std::string content_type(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".js") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json") return "application/json";
+  if (ext == ".png") return "image/png";
+  return "application/octet-stream";
+}
+
+// The file a request path names inside `root`, or nothing. httplib has already percent-decoded
+// the path, so "%2e%2e%2f" arrives as "../" and is refused here like a literal one; a '%' left
+// after decoding (double encoding) or a backslash is refused too. The canonical-prefix check
+// stays as a second wall should a segment test ever miss a case.
+std::optional<fs::path> asset_file(const fs::path& root, const std::string& request_path) {
+  std::string relative = request_path == "/" ? "index.html" : request_path.substr(1);
+  // three.js lives under the npm folder; the page imports it as /vendor/three/...
+  const std::string vendor = "vendor/three/";
+  if (relative.rfind(vendor, 0) == 0)
+    relative = "node_modules/three/" + relative.substr(vendor.size());
+  if (relative.find_first_of("\\%") != std::string::npos ||
+      relative.find('\0') != std::string::npos) {
+    return std::nullopt;
+  }
+  for (const fs::path& part : fs::path(relative)) {
+    if (part == ".." || part == "." || part.is_absolute() || part.has_root_name())
+      return std::nullopt;
+  }
+  std::error_code failure;
+  const fs::path canonical_root = fs::canonical(root, failure);
+  if (failure) return std::nullopt;
+  const fs::path file = fs::weakly_canonical(canonical_root / relative, failure);
+  if (failure) return std::nullopt;
+  const auto [root_end, unused] =
+      std::mismatch(canonical_root.begin(), canonical_root.end(), file.begin(), file.end());
+  if (root_end != canonical_root.end()) return std::nullopt;
+  if (!fs::is_regular_file(file, failure)) return std::nullopt;
+  return file;
+}
+
+// The listening thread; stopping and joining in the destructor means an exception on the main
+// thread can never leave it running.
+class ServerThread {
+ public:
+  explicit ServerThread(httplib::Server& server)
+      : server_(server), thread_([this] { server_.listen_after_bind(); }) {}
+  ~ServerThread() {
+    server_.stop();
+    thread_.join();
+  }
+  ServerThread(const ServerThread&) = delete;
+  ServerThread& operator=(const ServerThread&) = delete;
+
+ private:
+  httplib::Server& server_;
+  std::thread thread_;
+};
+
+int view(const ViewOptions& options) {
+  const Endpoint endpoint = parse_endpoint(options.viewer);
+  const fs::path web_root = data_dir() / "web";
+  if (!fs::is_regular_file(web_root / "index.html") ||
+      !fs::is_regular_file(web_root / "node_modules/three/build/three.module.js")) {
+    throw Error(web_root.string() +
+                ": the viewer's page or three.js is missing (scripts/install-deps runs 'npm ci' "
+                "in web/)");
+  }
+  const RunData data = load_run(options);
+
+  httplib::Server server;
+  const auto json_route = [&server](const std::string& route, const std::string& body) {
+    server.Get(route, [&body](const httplib::Request&, httplib::Response& response) {
+      response.set_content(body, "application/json");
+    });
+  };
+  json_route("/api/trajectory", data.trajectory);
+  json_route("/api/stats", data.stats);
+  json_route("/api/map", data.map);
+  json_route("/api/groundtruth", data.ground_truth);
+  server.Get(R"(/.*)", [&web_root](const httplib::Request& request, httplib::Response& response) {
+    const std::optional<fs::path> file = asset_file(web_root, request.path);
+    if (!file) {
+      response.status = 404;
+      response.set_content("not found\n", "text/plain");
+      return;
+    }
+    std::ifstream stream(*file, std::ios::binary);
+    response.set_content(std::string(std::istreambuf_iterator<char>(stream), {}),
+                         content_type(*file).c_str());
+  });
+
+  int port = endpoint.port;
+  if (port == 0) {
+    port = server.bind_to_any_port(endpoint.host.c_str());
+  } else if (!server.bind_to_port(endpoint.host.c_str(), port)) {
+    port = -1;
+  }
+  if (port <= 0) {
+    throw Error("--viewer " + options.viewer + ": cannot listen on " + endpoint.host + ":" +
+                std::to_string(endpoint.port) +
+                " (port in use, or not an address of this machine)");
+  }
+  if (!is_loopback(endpoint.host)) {
+    spdlog::warn("the viewer listens on {}: anyone who can reach this machine can see the run",
+                 endpoint.host);
+  }
+  // The guard exists before the address is printed: a Ctrl-C from then on stops the server
+  // cleanly instead of killing the process.
+  InterruptGuard guard;
+  {
+    ServerThread thread(server);
+    const bool v6 = endpoint.host.find(':') != std::string::npos;
+    std::cout << "viewer: http://" << (v6 ? "[" + endpoint.host + "]" : endpoint.host) << ":"
+              << port << "/  (" << data.poses << " poses; Ctrl-C stops)" << std::endl;
+    while (!interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  clear_interrupt();
+  std::cout << "viewer stopped" << std::endl;
+  return 0;
+}
+
+}  // namespace
+
+Command add_view_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "view",
+      "show a finished run in the browser (no SLAM runs).\n"
+      "Serves a 3D view of RUN_DIR's map (map.ply, from 'run --export-map RUN_DIR/map.ply'), "
+      "keyframes,\ntrajectory and aligned ground truth, with the counters of stats.json.");
+  auto options = std::make_shared<ViewOptions>();
+  app->add_option("RUN_DIR", options->run_dir, "output folder of 'pspslam run --out'")->required();
+  app->add_option("--viewer", options->viewer,
+                  "[HOST:]PORT to listen on (host 127.0.0.1 unless given; port 0: any free one)")
+      ->capture_default_str();
+  app->add_option("--gt", options->gt_file,
+                  "ground-truth trajectory (default: groundtruth.txt of the sequence named in "
+                  "stats.json, when there is one)");
+  return {app, [options](const GlobalOptions&) { return view(*options); }};
+}
+
+}  // namespace pspslam::cli

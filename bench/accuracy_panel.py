@@ -330,7 +330,8 @@ def summarise(cells, base, variant, spread, args):
 
     lines += ["",
               f"- paired, final trajectory: variant wins {wins}, loses {losses} "
-              f"({bad_losses} by more than the cell's spread) of {len(deltas['final'])} cells; "
+              f"({bad_losses} by more than the cell's spread), ties "
+              f"{len(deltas['final']) - wins - losses} of {len(deltas['final'])} cells; "
               f"median Δ {signed_mm(median_delta)} mm (online: median Δ "
               f"{signed_mm(median_online)} mm)",
               f"- keyframes after BA closer to the ground truth than the online poses: baseline "

@@ -5,17 +5,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/core/error.h"
+#include "pspslam/synth/sensor.h"
 #include "pspslam/synth/texture.h"
 
 namespace pspslam::synth {
-namespace {
-
-constexpr size_t kNormalTableSize = 1 << 16;
-
-// A depth jump that the projector shadow and mixed pixels show up at.
-bool is_jump(float a, float b) { return std::abs(a - b) > 0.02f + 0.02f * std::min(a, b); }
-
-}  // namespace
 
 const std::vector<std::string>& KinectFaults::names() {
   static const std::vector<std::string> kNames = {
@@ -57,16 +50,7 @@ std::string KinectFaults::describe() const {
 }
 
 KinectDepthModel::KinectDepthModel(uint64_t seed, double focal_px)
-    : seed_(mix_hash(seed, 0x41EC7u)), focal_px_(focal_px) {
-  normals_.resize(kNormalTableSize);
-  for (size_t i = 0; i < kNormalTableSize; i += 2) {
-    const double u1 = std::max(1e-12, hash_to_unit(mix_hash(seed_, i)));
-    const double u2 = hash_to_unit(mix_hash(seed_, i + 1));
-    const double radius = std::sqrt(-2.0 * std::log(u1));
-    normals_[i] = static_cast<float>(radius * std::cos(2.0 * M_PI * u2));
-    normals_[i + 1] = static_cast<float>(radius * std::sin(2.0 * M_PI * u2));
-  }
-}
+    : seed_(mix_hash(seed, 0x41EC7u)), focal_px_(focal_px), normals_(make_normal_table(seed_)) {}
 
 double KinectDepthModel::shadow_width_px(double z_near, double z_far) const {
   return focal_px_ * kKinectBaseline_m * (1.0 / z_near - 1.0 / z_far);
@@ -117,39 +101,14 @@ void KinectDepthModel::apply(const cv::Mat& exact, const cv::Mat& incidence_cos,
   }
   if (!switches.holes) return;
 
-  // Projector shadow: the projector sits to the right of the IR camera (as seen from behind),
-  // so background just left of a foreground edge gets no pattern; mixed pixels on both sides of
-  // every jump are invalidated too, as the Kinect's own filter does.
-  for (int y = 0; y < height; ++y) {
-    const float* z_row = exact.ptr<float>(y);
-    float* out_row = out.ptr<float>(y);
-    for (int x = 1; x < width; ++x) {
-      const float left = z_row[x - 1], right = z_row[x];
-      if (!is_jump(left, right)) continue;
-      out_row[x - 1] = 0.0f;
-      out_row[x] = 0.0f;
-      if (left > right && right > 0.0f) {
-        const int shadow =
-            std::min(64, static_cast<int>(std::lround(shadow_width_px(right, left))));
-        for (int k = x - 2; k >= std::max(0, x - shadow); --k) {
-          if (!is_jump(z_row[k], right)) break;  // the shadow ends on nearer surfaces
-          out_row[k] = 0.0f;
-        }
-      }
-    }
-  }
-  for (int y = 1; y < height; ++y) {
-    const float* above = exact.ptr<float>(y - 1);
-    const float* here = exact.ptr<float>(y);
-    float* out_above = out.ptr<float>(y - 1);
-    float* out_here = out.ptr<float>(y);
-    for (int x = 0; x < width; ++x) {
-      if (is_jump(above[x], here[x])) {
-        out_above[x] = 0.0f;
-        out_here[x] = 0.0f;
-      }
-    }
-  }
+  // Mixed pixels and the projector shadow (its full geometric width, at most 64 px, the mixed
+  // pixel included) at depth jumps.
+  clear_depth_discontinuities(
+      exact,
+      [this](float z_near, float z_far) {
+        return std::min(64, static_cast<int>(std::lround(shadow_width_px(z_near, z_far)))) - 1;
+      },
+      out);
 }
 
 double kinect_sync_offset(uint64_t seed, size_t index) {

@@ -27,6 +27,7 @@ Command add_synth_command(CLI::App& root) {
     std::string sensor = "ideal";
     std::vector<std::string> no_faults;
     std::string out;
+    std::string layout = "tum";
   };
   auto flags = std::make_shared<Flags>();
   SynthOptions& options = flags->options;
@@ -74,6 +75,14 @@ Command add_synth_command(CLI::App& root) {
   app->add_option("--carried-objects", options.carried_objects, "people carrying a box (label 100)")
       ->check(in_range(0, kMaxBodies))
       ->capture_default_str();
+  app->add_option("--stereo", options.stereo_baseline,
+                  "also render a rectified right camera BASELINE_M metres to the right and write "
+                  "the stereo config (right/, right.txt; config_rgbd.yaml keeps the RGB-D one)");
+  app->add_option("--layout", flags->layout,
+                  "tum, or kitti (needs --stereo): KITTI odometry layout (image_0/, image_1/, "
+                  "times.txt, calib.txt, poses.txt)")
+      ->check(CLI::IsMember({"tum", "kitti"}))
+      ->capture_default_str();
   app->add_option("--threads", options.threads, "worker threads (0 = all cores)")
       ->check(in_range(0, 256))
       ->capture_default_str();
@@ -82,6 +91,7 @@ Command add_synth_command(CLI::App& root) {
             options.trajectory = parse_synth_trajectory(flags->trajectory);
             options.depth_noise = flags->depth_noise == "on";
             options.sensor = parse_synth_sensor(flags->sensor);
+            options.kitti_layout = flags->layout == "kitti";
             if (!flags->no_faults.empty() && options.sensor != SynthSensor::kKinect) {
               throw Error("synth: flag --no-fault needs --sensor kinect");
             }

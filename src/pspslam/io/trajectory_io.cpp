@@ -202,7 +202,8 @@ void write_kitti_trajectory(const std::filesystem::path& file, const Trajectory&
   if (!out) throw Error(file.string() + ": cannot write trajectory file");
   char line[512];
   for (const StampedPose& stamped : trajectory) {
-    const Eigen::Matrix4d m = stamped.T_world_camera.matrix();
+    // + 0.0 turns -0 into 0: the same pose always prints the same bytes.
+    const Eigen::Matrix4d m = stamped.T_world_camera.matrix().array() + 0.0;
     std::snprintf(line, sizeof(line),
                   "%.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e\n", m(0, 0), m(0, 1),
                   m(0, 2), m(0, 3), m(1, 0), m(1, 1), m(1, 2), m(1, 3), m(2, 0), m(2, 1), m(2, 2),

@@ -65,16 +65,19 @@ class StereoFrameBuilder final : public FrameBuilder {
   }
 
   StereoFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
-                     std::shared_ptr<const ScalePyramid> pyramid)
+                     std::shared_ptr<const ScalePyramid> pyramid, bool dense_depth)
       : left_extractor_(orb),
         right_extractor_(right_config(orb)),
         camera_(std::move(camera)),
-        pyramid_(std::move(pyramid)) {
-    // Disparities up to the nearest depth matched sparsely, rounded up to SGBM's multiple of 16
-    // and capped at 128 (SGBM's cost grows linearly with it; nearer pixels get no depth).
-    const double max_disparity = camera_->bf / matching_.min_depth_m;
+        pyramid_(std::move(pyramid)),
+        dense_depth_(dense_depth) {
+    // SGBM runs at half resolution: its cost grows with width x height x disparities, so this
+    // is ~5x cheaper, and the dynamic pipeline's depth tests tolerate 4 cm + 4 % (geometry/).
+    // Disparities up to the nearest depth matched sparsely, rounded up to SGBM's multiple of 16,
+    // capped at 96 (nearer pixels get no depth).
+    const double max_disparity = 0.5 * camera_->bf / matching_.min_depth_m;
     const int disparities =
-        std::clamp(static_cast<int>(std::ceil(max_disparity / 16.0)) * 16, 16, 128);
+        std::clamp(static_cast<int>(std::ceil(max_disparity / 16.0)) * 16, 16, 96);
     constexpr int kBlock = 5;
     sgbm_ =
         cv::StereoSGBM::create(0, disparities, kBlock, 8 * kBlock * kBlock, 32 * kBlock * kBlock, 1,
@@ -92,25 +95,23 @@ class StereoFrameBuilder final : public FrameBuilder {
                   " but the left is " + std::to_string(gray.cols) + "x" +
                   std::to_string(gray.rows));
     }
+    left_gray_ = gray;
+    // The dense depth needs only the two images: it runs beside both extractions.
+    if (dense_depth_) {
+      dense_ = std::async(std::launch::async, [this, left = gray, right = frame.right] {
+        return sgbm_depth(left, right);
+      });
+    }
     auto right = std::async(std::launch::async, [&] {
       right_extractor_.extract(frame.right, cv::Mat(), right_features_);
     });
     left_extractor_.extract(gray, mask, features);
     right.get();
-    left_gray_ = gray;
   }
 
   cv::Mat depth_image(const RgbdFrame& frame) override {
-    cv::Mat disparity;
-    sgbm_->compute(left_gray_, frame.right, disparity);  // CV_16S, 16 x disparity
-    cv::Mat depth(disparity.size(), CV_32F);
-    const float bf16 = static_cast<float>(camera_->bf * 16.0);
-    for (int y = 0; y < disparity.rows; ++y) {
-      const std::int16_t* d = disparity.ptr<std::int16_t>(y);
-      float* z = depth.ptr<float>(y);
-      for (int x = 0; x < disparity.cols; ++x) z[x] = d[x] > 0 ? bf16 / d[x] : 0.0f;
-    }
-    return depth;
+    if (dense_.valid()) return dense_.get();
+    return sgbm_depth(left_gray_, frame.right);
   }
 
   Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
@@ -131,17 +132,41 @@ class StereoFrameBuilder final : public FrameBuilder {
   cv::Mat left_gray_;  // of the frame being built (shared, not copied)
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
+  // CV_32F metres at full resolution from SGBM at half resolution (nearest-neighbour upsampling:
+  // interpolating across a depth edge would invent depths between the two surfaces).
+  cv::Mat sgbm_depth(const cv::Mat& left, const cv::Mat& right) const {
+    cv::Mat left_half, right_half, disparity;
+    cv::resize(left, left_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    cv::resize(right, right_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    sgbm_->compute(left_half, right_half, disparity);  // CV_16S, 16 x half-resolution disparity
+    cv::Mat depth_half(disparity.size(), CV_32F);
+    // z = bf / d_full = bf / (2 d_half) = bf * 16 / (2 * value).
+    const float bf8 = static_cast<float>(camera_->bf * 8.0);
+    for (int y = 0; y < disparity.rows; ++y) {
+      const std::int16_t* d = disparity.ptr<std::int16_t>(y);
+      float* z = depth_half.ptr<float>(y);
+      for (int x = 0; x < disparity.cols; ++x) z[x] = d[x] > 0 ? bf8 / d[x] : 0.0f;
+    }
+    cv::Mat depth;
+    cv::resize(depth_half, depth, left.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    return depth;
+  }
+
   StereoMatchOptions matching_;
   cv::Ptr<cv::StereoSGBM> sgbm_;
+  bool dense_depth_ = false;
+  std::future<cv::Mat> dense_;
 };
 
 }  // namespace
 
 std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
                                                  std::shared_ptr<const RgbdCamera> camera,
-                                                 std::shared_ptr<const ScalePyramid> pyramid) {
+                                                 std::shared_ptr<const ScalePyramid> pyramid,
+                                                 bool dense_depth) {
   if (config.camera.type == SensorType::stereo) {
-    return std::make_unique<StereoFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
+    return std::make_unique<StereoFrameBuilder>(config.orb, std::move(camera), std::move(pyramid),
+                                                dense_depth);
   }
   return std::make_unique<RgbdFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
 }

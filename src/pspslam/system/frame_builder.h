@@ -38,9 +38,11 @@ class FrameBuilder {
                       const cv::Mat& depth) = 0;
 };
 
-// The builder of `config.camera.type`.
+// The builder of `config.camera.type`. `dense_depth`: depth_image() will be called every frame
+// (a dynamic pipeline runs), so a stereo builder computes it beside the extraction.
 std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
                                                  std::shared_ptr<const RgbdCamera> camera,
-                                                 std::shared_ptr<const ScalePyramid> pyramid);
+                                                 std::shared_ptr<const ScalePyramid> pyramid,
+                                                 bool dense_depth);
 
 }  // namespace pspslam

@@ -173,7 +173,8 @@ System::System(const SystemConfig& config, SystemOptions options)
     : camera_(std::make_shared<const RgbdCamera>(
           RgbdCamera::from_config(config.camera, options.virtual_baseline))),
       pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
-      frame_builder_(make_frame_builder(config, camera_, pyramid_)),
+      frame_builder_(
+          make_frame_builder(config, camera_, pyramid_, options.dynamic.mode != DynamicMode::off)),
       extractor_(std::make_unique<OrbExtractor>(config.orb)),
       map_(std::make_shared<Map>()) {
   if (options.localization_only) {

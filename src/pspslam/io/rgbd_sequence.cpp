@@ -1,5 +1,6 @@
 #include "pspslam/io/rgbd_sequence.h"
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdio>
 #include <limits>
@@ -226,7 +227,119 @@ void RgbdSequence::keep_present_frames(std::vector<FrameFiles> associated,
 }
 
 std::string to_string(SequenceLayout layout) {
-  return layout == SequenceLayout::kitti ? "kitti" : "tum";
+  switch (layout) {
+    case SequenceLayout::kitti:
+      return "kitti";
+    case SequenceLayout::euroc:
+      return "euroc";
+    case SequenceLayout::tum:
+      break;
+  }
+  return "tum";
+}
+
+namespace {
+
+// cam0/data.csv or cam1/data.csv: `timestamp_ns,filename` rows (header comment skipped).
+std::vector<ListedFile> read_euroc_list(const std::filesystem::path& file,
+                                        const std::string& folder) {
+  if (!std::filesystem::exists(file)) throw Error(file.string() + ": not found");
+  std::vector<ListedFile> list;
+  for_each_data_line(file, "EuRoC image list", [&](const TextLine& line) {
+    if (line.fields.size() != 2) {
+      throw Error(line_prefix(file, line.line) + "expected 'timestamp [ns],filename', got " +
+                  std::to_string(line.fields.size()) + " fields");
+    }
+    const double ns = parse_number(line.fields[0], file, line.line, "timestamp");
+    list.push_back({ns * 1e-9, folder + "/data/" + std::string(line.fields[1])});
+  });
+  return list;
+}
+
+// state_groundtruth_estimate0/data.csv: timestamp, p_RS_R (3), q_RS (w x y z), then velocities
+// and biases; the body pose T_world_body.
+Trajectory read_euroc_ground_truth(const std::filesystem::path& file, const Pose& T_body_camera) {
+  Trajectory trajectory;
+  for_each_data_line(file, "EuRoC ground truth", [&](const TextLine& line) {
+    if (line.fields.size() < 8) {
+      throw Error(line_prefix(file, line.line) +
+                  "expected 'timestamp, p x y z, q w x y z, ...', got " +
+                  std::to_string(line.fields.size()) + " fields");
+    }
+    double v[8];
+    for (size_t k = 0; k < 8; ++k) v[k] = parse_number(line.fields[k], file, line.line, "value");
+    const Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
+    if (std::abs(q.norm() - 1.0) > 1e-3) {
+      throw Error(line_prefix(file, line.line) + "quaternion has norm " + std::to_string(q.norm()) +
+                  ", expected a unit quaternion");
+    }
+    Pose T_world_body = Pose::Identity();
+    T_world_body.linear() = q.normalized().toRotationMatrix();
+    T_world_body.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    trajectory.push_back({v[0] * 1e-9, T_world_body * T_body_camera});
+  });
+  return trajectory;
+}
+
+}  // namespace
+
+RgbdSequence RgbdSequence::open_euroc(const std::filesystem::path& dir,
+                                      const SequenceOptions& options) {
+  if (!std::filesystem::is_directory(dir)) {
+    throw Error(dir.string() + ": sequence directory not found");
+  }
+  const std::filesystem::path mav =
+      std::filesystem::exists(dir / "mav0" / "cam0") ? dir / "mav0" : dir;
+  if (!std::filesystem::exists(mav / "cam0" / "data.csv")) {
+    throw Error(dir.string() +
+                ": no mav0/cam0/data.csv (an EuRoC MAV sequence needs mav0/cam0 and mav0/cam1, "
+                "each with data.csv, data/ and sensor.yaml)");
+  }
+  RgbdSequence sequence;
+  sequence.dir_ = mav;
+  sequence.options_ = options;
+  sequence.options_.stereo = true;
+  sequence.layout_ = SequenceLayout::euroc;
+  const EurocCamera left = read_euroc_camera(mav / "cam0" / "sensor.yaml");
+  const EurocCamera right = read_euroc_camera(mav / "cam1" / "sensor.yaml");
+  sequence.rectification_ =
+      std::make_shared<const StereoRectification>(StereoRectification::compute(
+          left, right, (mav / "cam0" / "sensor.yaml").string() + " and " + "cam1/sensor.yaml"));
+  const std::vector<ListedFile> cam0 = read_euroc_list(mav / "cam0" / "data.csv", "cam0");
+  const std::vector<ListedFile> cam1 = read_euroc_list(mav / "cam1" / "data.csv", "cam1");
+  sequence.listed_rgb_ = cam0.size();
+  sequence.listed_depth_ = cam1.size();
+  std::vector<Timestamp> t0, t1;
+  std::vector<std::string> listed;
+  for (const ListedFile& f : cam0) {
+    t0.push_back(f.timestamp);
+    listed.push_back(f.file);
+  }
+  for (const ListedFile& f : cam1) {
+    t1.push_back(f.timestamp);
+    listed.push_back(f.file);
+  }
+  // The two cameras are triggered together: their stamps agree to well under a millisecond.
+  std::vector<FrameFiles> associated;
+  for (const TimestampMatch& m : associate_timestamps(t0, t1, 1e-3)) {
+    associated.push_back({cam0[m.first].timestamp, cam0[m.first].file, cam1[m.second].timestamp,
+                          cam1[m.second].file});
+  }
+  sequence.keep_present_frames(std::move(associated), listed);
+  if (sequence.frames_.empty()) {
+    throw Error(dir.string() + ": no stereo frame: " + std::to_string(cam0.size()) + " cam0 and " +
+                std::to_string(cam1.size()) +
+                " cam1 images listed, none paired within 1 ms with both files present");
+  }
+  const std::filesystem::path ground_truth = mav / "state_groundtruth_estimate0" / "data.csv";
+  if (std::filesystem::exists(ground_truth)) {
+    // The rectified left camera: x_rect = R x_cam0, so T_cam0_rect rotates by R^T.
+    Pose T_cam0_rect = Pose::Identity();
+    T_cam0_rect.linear() = sequence.rectification_->R_rect_left.transpose();
+    sequence.ground_truth_ =
+        read_euroc_ground_truth(ground_truth, left.T_body_camera * T_cam0_rect);
+  }
+  return sequence;
 }
 
 KittiCalibration read_kitti_calibration(const std::filesystem::path& file) {
@@ -346,6 +459,12 @@ RgbdFrame RgbdSequence::load(size_t i) const {
       throw Error(rgb_path.string() + " is " + std::to_string(frame.bgr.cols) + "x" +
                   std::to_string(frame.bgr.rows) + " but " + depth_path.string() + " is " +
                   std::to_string(frame.right.cols) + "x" + std::to_string(frame.right.rows));
+    }
+    if (rectification_) {
+      cv::Mat left, right;
+      rectification_->rectify(frame.bgr, frame.right, left, right);
+      frame.bgr = left;
+      frame.right = right;
     }
     if (options_.load_gray) cv::cvtColor(frame.bgr, frame.gray, cv::COLOR_BGR2GRAY);
     return frame;

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/io/association.h"
+#include "pspslam/io/euroc.h"
 
 namespace pspslam {
 
@@ -36,6 +38,7 @@ struct SequenceOptions {
 enum class SequenceLayout {
   tum,    // rgb.txt + depth.txt or associations.txt (or rgb.txt + right.txt for stereo)
   kitti,  // KITTI odometry: times.txt, calib.txt, image_0/, image_1/, optional poses.txt
+  euroc,  // EuRoC MAV: mav0/cam0, mav0/cam1 (data.csv, data/, sensor.yaml), unrectified
 };
 std::string to_string(SequenceLayout layout);
 
@@ -91,6 +94,16 @@ class RgbdSequence {
   // image files are counted and their frames skipped with one warning, as for TUM.
   static RgbdSequence open_kitti(const std::filesystem::path& dir,
                                  const SequenceOptions& options = {});
+  // EuRoC MAV layout (stereo): DIR/mav0 (or DIR itself when it is mav0) with cam0/ and cam1/,
+  // each data.csv (`#timestamp [ns],filename`), data/<file> and sensor.yaml. The pair is
+  // rectified from the two sensor.yaml (cv::stereoRectify + remap) as frames load; cam0 and cam1
+  // rows are paired by equal timestamps. Ground truth, when
+  // mav0/state_groundtruth_estimate0/data.csv exists, is moved from the body (IMU) onto the
+  // rectified left camera. Missing image files are counted once and their frames skipped.
+  static RgbdSequence open_euroc(const std::filesystem::path& dir,
+                                 const SequenceOptions& options = {});
+  // The rectification of an EuRoC pair (null for rectified layouts).
+  const std::shared_ptr<const StereoRectification>& rectification() const { return rectification_; }
 
   size_t size() const { return frames_.size(); }
   bool empty() const { return frames_.empty(); }
@@ -133,6 +146,7 @@ class RgbdSequence {
   std::vector<FrameFiles> frames_;
   std::optional<Trajectory> ground_truth_;
   SequenceLayout layout_ = SequenceLayout::tum;
+  std::shared_ptr<const StereoRectification> rectification_;
   bool used_associations_file_ = false;
   size_t listed_rgb_ = 0;
   size_t listed_depth_ = 0;

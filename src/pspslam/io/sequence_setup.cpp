@@ -55,6 +55,38 @@ SequenceSetup open_kitti_with_config(const std::filesystem::path& dir,
   return SequenceSetup{config_path, config, std::move(sequence)};
 }
 
+SequenceSetup open_euroc_with_config(const std::filesystem::path& dir,
+                                     const std::optional<std::filesystem::path>& config_file,
+                                     std::ostream* warnings) {
+  SystemConfig config;
+  std::filesystem::path config_path = dir / "mav0" / "cam0" / "sensor.yaml";
+  if (config_file) {
+    config = load_config(*config_file);
+    config_path = *config_file;
+  }
+  SequenceOptions options;
+  options.warnings = warnings;
+  RgbdSequence sequence = RgbdSequence::open_euroc(dir, options);
+  const StereoRectification& rect = *sequence.rectification();
+  const EurocCamera left = read_euroc_camera(sequence.directory() / "cam0" / "sensor.yaml");
+  CameraConfig& camera = config.camera;
+  if (!config_file) camera.name = "euroc";
+  camera.type = SensorType::stereo;
+  camera.pinhole.width = rect.size.width;
+  camera.pinhole.height = rect.size.height;
+  camera.pinhole.fx = rect.fx;
+  camera.pinhole.fy = rect.fy;
+  camera.pinhole.cx = rect.cx;
+  camera.pinhole.cy = rect.cy;
+  camera.pinhole.distortion = {};  // the frames are rectified as they load
+  camera.baseline = rect.baseline;
+  if (!config_file) {
+    camera.depth_threshold = 40.0 * camera.baseline;
+    camera.fps = left.rate_hz;
+  }
+  return SequenceSetup{config_path, config, std::move(sequence)};
+}
+
 }  // namespace
 
 SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
@@ -69,6 +101,15 @@ SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
                   " is a KITTI odometry sequence (stereo)");
     }
     return open_kitti_with_config(dir, config_file, warnings);
+  }
+  if (std::filesystem::exists(dir / "mav0" / "cam0" / "data.csv") ||
+      (std::filesystem::exists(dir / "cam0" / "data.csv") &&
+       std::filesystem::exists(dir / "cam1" / "data.csv"))) {
+    if (sensor && *sensor != SensorType::stereo) {
+      throw Error("--sensor " + to_string(*sensor) + ": " + dir.string() +
+                  " is a EuRoC MAV sequence (stereo)");
+    }
+    return open_euroc_with_config(dir, config_file, warnings);
   }
   std::filesystem::path config_path;
   if (config_file) {
@@ -97,7 +138,10 @@ std::string describe_sequence(const SequenceSetup& setup) {
   char line[512];
   out << "sequence:     " << s.directory().string() << "\n";
   char how[64];
-  if (s.used_associations_file()) {
+  if (s.layout() != SequenceLayout::tum) {
+    std::snprintf(how, sizeof(how), "paired as the %s layout lists them",
+                  to_string(s.layout()).c_str());
+  } else if (s.used_associations_file()) {
     std::snprintf(how, sizeof(how), "in associations.txt");
   } else {
     std::snprintf(how, sizeof(how), "associated within %g s", s.options().max_difference);

@@ -107,11 +107,19 @@ StereoRectification StereoRectification::compute(const EurocCamera& left, const 
     t[i] = T_right_left.translation()[i];
     for (int j = 0; j < 3; ++j) R(i, j) = T_right_left.linear()(i, j);
   }
+  // stereoRectify asserts on a zero baseline (found by fuzz/fuzz_stereo_layouts).
+  if (T_right_left.translation().norm() < 1e-6) {
+    throw Error(what + ": the two cameras are at the same place (T_BS): no stereo baseline");
+  }
   const cv::Size size(left.width, left.height);
   cv::Mat R1, R2, P1, P2, Q;
-  // alpha 0: only valid pixels in the rectified images (no black borders to extract from).
-  cv::stereoRectify(left.K, left.distortion, right.K, right.distortion, size, R, t, R1, R2, P1, P2,
-                    Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+  try {
+    // alpha 0: only valid pixels in the rectified images (no black borders to extract from).
+    cv::stereoRectify(left.K, left.distortion, right.K, right.distortion, size, R, t, R1, R2, P1,
+                      P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+  } catch (const cv::Exception& e) {
+    throw Error(what + ": cv::stereoRectify failed: " + e.err);
+  }
   if (std::abs(P2.at<double>(1, 3)) > std::abs(P2.at<double>(0, 3))) {
     throw Error(what +
                 ": the right camera is above or below the left one (a vertical pair); "

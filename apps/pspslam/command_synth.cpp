@@ -79,9 +79,10 @@ Command add_synth_command(CLI::App& root) {
                   "also render a rectified right camera BASELINE_M metres to the right and write "
                   "the stereo config (right/, right.txt; config_rgbd.yaml keeps the RGB-D one)");
   app->add_option("--layout", flags->layout,
-                  "tum, or kitti (needs --stereo): KITTI odometry layout (image_0/, image_1/, "
-                  "times.txt, calib.txt, poses.txt)")
-      ->check(CLI::IsMember({"tum", "kitti"}))
+                  "tum, kitti or euroc (both need --stereo): KITTI odometry (image_0/, "
+                  "image_1/, times.txt, calib.txt, poses.txt) or EuRoC MAV (mav0/cam0, cam1, "
+                  "state_groundtruth_estimate0)")
+      ->check(CLI::IsMember({"tum", "kitti", "euroc"}))
       ->capture_default_str();
   app->add_option("--threads", options.threads, "worker threads (0 = all cores)")
       ->check(in_range(0, 256))
@@ -91,7 +92,9 @@ Command add_synth_command(CLI::App& root) {
             options.trajectory = parse_synth_trajectory(flags->trajectory);
             options.depth_noise = flags->depth_noise == "on";
             options.sensor = parse_synth_sensor(flags->sensor);
-            options.kitti_layout = flags->layout == "kitti";
+            options.layout = flags->layout == "kitti"   ? SynthOptions::Layout::kitti
+                             : flags->layout == "euroc" ? SynthOptions::Layout::euroc
+                                                        : SynthOptions::Layout::tum;
             if (!flags->no_faults.empty() && options.sensor != SynthSensor::kKinect) {
               throw Error("synth: flag --no-fault needs --sensor kinect");
             }

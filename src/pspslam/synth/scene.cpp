@@ -204,8 +204,8 @@ void SynthOptions::validate() const {
                 std::to_string(stereo_baseline));
   if (stereo_baseline > 0.0 && sensor == SynthSensor::kKinect)
     throw Error("synth: flag --stereo renders the ideal sensor only (not --sensor kinect)");
-  if (kitti_layout && stereo_baseline <= 0.0)
-    throw Error("synth: flag --layout kitti needs --stereo BASELINE_M (KITTI is a stereo layout)");
+  if (layout != Layout::tum && stereo_baseline <= 0.0)
+    throw Error("synth: flag --layout kitti|euroc needs --stereo BASELINE_M (stereo layouts)");
 }
 
 CameraConfig synthetic_camera_config() {

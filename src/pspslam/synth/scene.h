@@ -51,8 +51,10 @@ struct SynthOptions {
   // `--stereo BASELINE_M`: also render a rectified right camera this far along the left
   // camera's x axis (same intrinsics, same instant); 0 = RGB-D only. Ideal sensor only.
   double stereo_baseline = 0.0;
-  // `--layout kitti` (needs stereo): write the KITTI odometry layout instead of TUM's.
-  bool kitti_layout = false;
+  // `--layout kitti|euroc` (needs stereo): write the KITTI odometry or EuRoC MAV layout
+  // instead of TUM's.
+  enum class Layout { tum, kitti, euroc };
+  Layout layout = Layout::tum;
 
   // Throws pspslam::Error naming the offending CLI flag (--frames, --bodies, ...).
   void validate() const;

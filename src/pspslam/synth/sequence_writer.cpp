@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <atomic>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <exception>
@@ -62,7 +63,10 @@ std::string stereo_flags(const SynthOptions& options) {
   if (!(options.stereo_baseline > 0.0)) return "";
   char text[64];
   std::snprintf(text, sizeof(text), " --stereo %g", options.stereo_baseline);
-  return std::string(text) + (options.kitti_layout ? " --layout kitti" : "");
+  const char* layout = options.layout == SynthOptions::Layout::kitti   ? " --layout kitti"
+                       : options.layout == SynthOptions::Layout::euroc ? " --layout euroc"
+                                                                       : "";
+  return std::string(text) + layout;
 }
 
 std::string describe(const SynthOptions& options) {
@@ -209,6 +213,63 @@ void write_kitti_files(const fs::path& dir, const SyntheticScene& scene) {
   write_kitti_trajectory(dir / "poses.txt", scene.ground_truth());
 }
 
+std::string euroc_stamp(Timestamp t) {
+  return std::to_string(static_cast<long long>(std::llround(t * 1e9)));
+}
+
+// EuRoC MAV files: cam0 and cam1 (data.csv, sensor.yaml: the synthetic intrinsics, no
+// distortion, cam0 at the body origin and cam1 at (baseline, 0, 0), so rectification is the
+// identity) and the body's ground truth (= cam0's pose).
+void write_euroc_files(const fs::path& dir, const SyntheticScene& scene) {
+  const PinholeCamera& c = scene.camera();
+  for (int cam = 0; cam < 2; ++cam) {
+    const fs::path folder = dir / "mav0" / ("cam" + std::to_string(cam));
+    {
+      const fs::path file = folder / "data.csv";
+      std::ofstream out = open_text(file);
+      out << "#timestamp [ns],filename\n";
+      for (size_t i = 0; i < scene.frame_count(); ++i) {
+        const std::string stamp = euroc_stamp(scene.timestamp(i));
+        out << stamp << "," << stamp << ".png\n";
+      }
+      close_text(out, file);
+    }
+    const fs::path file = folder / "sensor.yaml";
+    std::ofstream out = open_text(file);
+    char text[1024];
+    std::snprintf(text, sizeof(text),
+                  "%%YAML:1.0\nsensor_type: camera\ncomment: pspslam synth cam%d\nT_BS:\n"
+                  "  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, %.9f, 0.0, 1.0, 0.0, 0.0,\n"
+                  "         0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\nrate_hz: 30\n"
+                  "resolution: [%d, %d]\ncamera_model: pinhole\n"
+                  "intrinsics: [%.9f, %.9f, %.9f, %.9f]\n"
+                  "distortion_model: radial-tangential\n"
+                  "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n",
+                  cam, cam == 1 ? scene.options().stereo_baseline : 0.0, c.width, c.height, c.fx,
+                  c.fy, c.cx, c.cy);
+    out << text;
+    close_text(out, file);
+  }
+  const fs::path file = dir / "mav0/state_groundtruth_estimate0/data.csv";
+  std::ofstream out = open_text(file);
+  out << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+         "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad "
+         "s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m "
+         "s^-2], b_a_RS_S_z [m s^-2]\n";
+  char line[512];
+  for (size_t i = 0; i < scene.frame_count(); ++i) {
+    const Pose pose = scene.ground_truth_pose(i);
+    Eigen::Quaterniond q(pose.linear());
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    const Eigen::Vector3d t = pose.translation();
+    std::snprintf(line, sizeof(line), "%s,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,0,0,0,0,0,0,0,0,0\n",
+                  euroc_stamp(scene.timestamp(i)).c_str(), t.x(), t.y(), t.z(), q.w(), q.x(), q.y(),
+                  q.z());
+    out << line;
+  }
+  close_text(out, file);
+}
+
 }  // namespace
 
 std::string format_timestamp(Timestamp timestamp) {
@@ -230,10 +291,12 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
     throw Error("synth: --out " + dir.string() + " exists and is not a directory");
   }
   const bool stereo = scene.options().stereo_baseline > 0.0;
-  const bool kitti = scene.options().kitti_layout;
+  const bool kitti = scene.options().layout == SynthOptions::Layout::kitti;
+  const bool euroc = scene.options().layout == SynthOptions::Layout::euroc;
   std::vector<const char*> folders = {"rgb", "depth", "mask"};
   if (stereo) folders.push_back("right");
   if (kitti) folders = {"image_0", "image_1"};
+  if (euroc) folders = {"mav0/cam0/data", "mav0/cam1/data", "mav0/state_groundtruth_estimate0"};
   for (const char* sub : folders) {
     fs::create_directories(dir / sub, ec);
     if (ec) throw Error("synth: cannot create " + (dir / sub).string() + ": " + ec.message());
@@ -264,7 +327,13 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
           scene.render_right(i, right, 1);
           cv::cvtColor(right, right, cv::COLOR_BGR2GRAY);
         }
-        if (kitti) {
+        if (euroc) {
+          // EuRoC's cameras are grey too; file names are the nanosecond stamps.
+          const std::string name = euroc_stamp(scene.timestamp(i)) + ".png";
+          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+          write_png(dir / "mav0/cam0/data" / name, gray);
+          write_png(dir / "mav0/cam1/data" / name, right);
+        } else if (kitti) {
           // KITTI's odometry pair is grey: the left is the colour image's grey conversion, which
           // is what the TUM-layout run extracts from, so both layouts track the same pixels.
           char name[32];
@@ -311,6 +380,11 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   if (first_error) std::rethrow_exception(first_error);
 
   write_ground_truth(dir, scene);
+  if (euroc) {
+    write_euroc_files(dir, scene);
+    write_info(dir, scene);
+    return;
+  }
   if (kitti) {
     // The camera comes from calib.txt; config.yaml would not be read in this layout.
     write_kitti_files(dir, scene);

@@ -181,8 +181,9 @@ TEST(EurocSequence, MalformedFilesNameFileLineAndKey) {
             std::string::npos);
 
   write_text(mav / "cam1" / "sensor.yaml", sensor_yaml(Pose::Identity(), kDistortion));
-  EXPECT_NE(error_of([&] { RgbdSequence::open_euroc(dir, quiet()); })
-                .find("the two cameras are at the same place (T_BS): no stereo baseline"),
+  EXPECT_NE(error_of([&] {
+              RgbdSequence::open_euroc(dir, quiet());
+            }).find("the two cameras are at the same place (T_BS): no stereo baseline"),
             std::string::npos);
 
   const fs::path empty = testing::make_temp_dir("euroc_empty");

@@ -30,6 +30,7 @@
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
+#include "pspslam/io/sequence_setup.h"
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/session/run_options.h"
@@ -103,6 +104,8 @@ struct RunFlags {
   std::string sequence;
   std::string camera;
   std::string config;
+  std::string sensor;  // empty: the config's camera.type
+  std::string trajectory_format = "tum";
   std::string out = "pspslam_out";
   size_t max_frames = 0;
   bool no_local_mapping = false;
@@ -136,6 +139,8 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   RunOptions options;
   options.sequence = flags.sequence;
   if (!flags.config.empty()) options.config = flags.config;
+  if (!flags.sensor.empty()) options.sensor = parse_sensor_type(flags.sensor, "--sensor");
+  options.outputs.kitti_trajectory = flags.trajectory_format == "kitti";
   options.max_frames = flags.max_frames;
   if (!flags.blackout.empty()) options.blackout = parse_blackout(flags.blackout);
   options.progress = !global.quiet;
@@ -176,6 +181,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     camera->config_file =
         flags.config.empty() ? camera_config_preset(spec) : std::filesystem::path(flags.config);
     camera->config = load_config(camera->config_file);
+    if (options.sensor) apply_sensor_override(camera->config, *options.sensor, camera->config_file);
     camera->source = open_camera(spec);
   }
   SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
@@ -215,6 +221,13 @@ Command add_run_command(CLI::App& root) {
   app->add_option("--config", flags->config,
                   "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
                   "else required; presets in config/)");
+  app->add_option("--sensor", flags->sensor,
+                  "rgbd | stereo: overrides the config's camera.type (monocular: not yet)");
+  app->add_option("--trajectory-format", flags->trajectory_format,
+                  "tum, or kitti: also write OUT/trajectory_refined_kitti.txt (3x4 row-major "
+                  "camera-to-world per tracked frame)")
+      ->check(CLI::IsMember({"tum", "kitti"}))
+      ->capture_default_str();
   app->add_option("--out", flags->out, "output folder")->capture_default_str();
   app->add_option("--max-frames", flags->max_frames, "process at most this many frames (0 = all)")
       ->check(in_range(size_t{0}, size_t{1000000000}))

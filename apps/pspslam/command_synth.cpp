@@ -27,6 +27,7 @@ Command add_synth_command(CLI::App& root) {
     std::string sensor = "ideal";
     std::vector<std::string> no_faults;
     std::string out;
+    std::string layout = "tum";
   };
   auto flags = std::make_shared<Flags>();
   SynthOptions& options = flags->options;
@@ -74,6 +75,15 @@ Command add_synth_command(CLI::App& root) {
   app->add_option("--carried-objects", options.carried_objects, "people carrying a box (label 100)")
       ->check(in_range(0, kMaxBodies))
       ->capture_default_str();
+  app->add_option("--stereo", options.stereo_baseline,
+                  "also render a rectified right camera BASELINE_M metres to the right and write "
+                  "the stereo config (right/, right.txt; config_rgbd.yaml keeps the RGB-D one)");
+  app->add_option("--layout", flags->layout,
+                  "tum, kitti or euroc (both need --stereo): KITTI odometry (image_0/, "
+                  "image_1/, times.txt, calib.txt, poses.txt) or EuRoC MAV (mav0/cam0, cam1, "
+                  "state_groundtruth_estimate0)")
+      ->check(CLI::IsMember({"tum", "kitti", "euroc"}))
+      ->capture_default_str();
   app->add_option("--threads", options.threads, "worker threads (0 = all cores)")
       ->check(in_range(0, 256))
       ->capture_default_str();
@@ -82,6 +92,9 @@ Command add_synth_command(CLI::App& root) {
             options.trajectory = parse_synth_trajectory(flags->trajectory);
             options.depth_noise = flags->depth_noise == "on";
             options.sensor = parse_synth_sensor(flags->sensor);
+            options.layout = flags->layout == "kitti"   ? SynthOptions::Layout::kitti
+                             : flags->layout == "euroc" ? SynthOptions::Layout::euroc
+                                                        : SynthOptions::Layout::tum;
             if (!flags->no_faults.empty() && options.sensor != SynthSensor::kKinect) {
               throw Error("synth: flag --no-fault needs --sensor kinect");
             }

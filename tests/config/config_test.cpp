@@ -129,6 +129,71 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
   EXPECT_EQ(config.camera.depth_noise, CameraConfig::DepthNoise::none);
 }
 
+// Stereo (issue #16): type, baseline or bf, the depth-image keys refused, monocular "not yet".
+constexpr const char* kStereoCamera =
+    "camera:\n"
+    "  name: pair\n"
+    "  type: stereo\n"
+    "  width: 640\n"
+    "  height: 480\n"
+    "  fx: 500\n"
+    "  fy: 500\n"
+    "  cx: 319.5\n"
+    "  cy: 239.5\n"
+    "  distortion: [0, 0, 0, 0]\n"
+    "  fps: 20\n"
+    "  baseline: 0.12\n";
+
+TEST(Config, StereoCameraReadsBaselineOrBfAndRoundTrips) {
+  const auto dir = testing::make_temp_dir("config_stereo");
+  const SystemConfig config = load_config(write_file(dir, kStereoCamera));
+  EXPECT_EQ(config.camera.type, SensorType::stereo);
+  EXPECT_DOUBLE_EQ(config.camera.baseline, 0.12);
+  EXPECT_DOUBLE_EQ(config.camera.depth_threshold, 40 * 0.12);  // 40 baselines by default
+  const SystemConfig from_bf =
+      load_config(write_file(dir, replace(kStereoCamera, "  baseline: 0.12\n", "  bf: 60\n")));
+  EXPECT_DOUBLE_EQ(from_bf.camera.baseline, 0.12);
+  save_config(dir / "saved.yaml", config);
+  const SystemConfig back = load_config(dir / "saved.yaml");
+  EXPECT_EQ(back.camera.type, SensorType::stereo);
+  EXPECT_DOUBLE_EQ(back.camera.baseline, 0.12);
+  EXPECT_DOUBLE_EQ(back.camera.depth_threshold, config.camera.depth_threshold);
+  // An rgbd config says nothing about the type and reads as before.
+  EXPECT_EQ(load_config(write_file(dir, kValidCamera)).camera.type, SensorType::rgbd);
+}
+
+TEST(Config, StereoErrorsNameFileLineAndKey) {
+  const auto dir = testing::make_temp_dir("config_stereo_errors");
+  auto file = write_file(dir, replace(kStereoCamera, "  type: stereo\n", "  type: monocular\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":3: key 'camera.type': monocular is not supported yet (issue "
+                                  "#16); use rgbd or stereo");
+  file = write_file(dir, replace(kStereoCamera, "  type: stereo\n", "  type: lidar\n"));
+  EXPECT_EQ(load_error(file),
+            file.string() + ":3: key 'camera.type': must be rgbd or stereo, got 'lidar'");
+  file = write_file(dir, replace(kStereoCamera, "  baseline: 0.12\n", ""));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ": a stereo camera needs exactly one of 'camera.baseline' "
+                                  "(metres) and 'camera.bf' (fx * baseline), got neither");
+  file =
+      write_file(dir, replace(kStereoCamera, "  baseline: 0.12\n", "  baseline: 0.12\n  bf: 60\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ": a stereo camera needs exactly one of 'camera.baseline' "
+                                  "(metres) and 'camera.bf' (fx * baseline), got both");
+  file = write_file(dir, replace(kStereoCamera, "  baseline: 0.12\n", "  baseline: -0.1\n"));
+  EXPECT_EQ(load_error(file), file.string() + ": key 'camera.baseline' must be > 0");
+  file =
+      write_file(dir, replace(kStereoCamera, "  fps: 20\n", "  fps: 20\n  depth_factor: 5000\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":12: key 'camera.depth_factor' is for rgbd cameras only "
+                                  "(camera.type is stereo)");
+  file = write_file(
+      dir, replace(kStereoCamera, "  baseline: 0.12\n", "  baseline: 0.12\n  basline: 1\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":13: unknown key 'camera.basline' (did you mean "
+                                  "'camera.baseline'?)");
+}
+
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
   const auto dir = testing::make_temp_dir("config");
   const auto file = write_file(dir, replace(kValidCamera, "  fx: 500.5\n", "  fxx: 500.5\n"));

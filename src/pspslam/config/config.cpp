@@ -18,9 +18,44 @@ void require_positive(double value, const YamlSection& section, const std::strin
   }
 }
 
+// The keys that describe a depth image make no sense for a stereo pair: name them rather than
+// call them unknown (they are valid keys, for another sensor).
+void refuse_depth_image_keys(const YamlSection& section) {
+  for (const char* key :
+       {"depth_factor", "depth_noise", "depth_noise_scale", "depth_registration_shift_px"}) {
+    if (section.contains(key)) {
+      throw Error(section.where(key) + "key '" + section.qualified(key) +
+                  "' is for rgbd cameras only (camera.type is stereo)");
+    }
+  }
+}
+
+void read_stereo_baseline(YamlSection& section, CameraConfig& camera) {
+  const bool has_baseline = section.contains("baseline");
+  const bool has_bf = section.contains("bf");
+  if (has_baseline == has_bf) {
+    throw Error(section.file() + ": a stereo camera needs exactly one of '" +
+                section.qualified("baseline") + "' (metres) and '" + section.qualified("bf") +
+                "' (fx * baseline)" + (has_bf ? ", got both" : ", got neither"));
+  }
+  if (has_baseline) {
+    camera.baseline = section.required<double>("baseline");
+    require_positive(camera.baseline, section, "baseline");
+  } else {
+    const double bf = section.required<double>("bf");
+    require_positive(bf, section, "bf");
+    camera.baseline = bf / camera.pinhole.fx;
+  }
+}
+
 CameraConfig read_camera(YamlSection section) {
   CameraConfig camera;
   camera.name = section.optional<std::string>("name", camera.name);
+  if (section.contains("type")) {
+    camera.type =
+        parse_sensor_type(section.required<std::string>("type"),
+                          section.where("type") + "key '" + section.qualified("type") + "'");
+  }
   PinholeCamera& p = camera.pinhole;
   p.width = section.required<int>("width");
   p.height = section.required<int>("height");
@@ -36,6 +71,19 @@ CameraConfig read_camera(YamlSection section) {
   }
   for (size_t i = 0; i < distortion.size(); ++i) p.distortion[i] = distortion[i];
   camera.fps = section.required<double>("fps");
+  require_positive(p.fx, section, "fx");
+  if (camera.type == SensorType::stereo) {
+    refuse_depth_image_keys(section);
+    read_stereo_baseline(section, camera);
+    camera.depth_threshold = section.optional("depth_threshold", 40.0 * camera.baseline);
+    require_positive(camera.depth_threshold, section, "depth_threshold");
+    require_positive(p.width, section, "width");
+    require_positive(p.height, section, "height");
+    require_positive(p.fy, section, "fy");
+    require_positive(camera.fps, section, "fps");
+    section.finish();
+    return camera;
+  }
   camera.depth_factor = section.required<double>("depth_factor");
   camera.depth_threshold = section.required<double>("depth_threshold");
   const auto depth_noise = section.optional<std::string>("depth_noise", "none");
@@ -87,6 +135,17 @@ OrbConfig read_orb(YamlSection section) {
 
 }  // namespace
 
+SensorType parse_sensor_type(const std::string& name, const std::string& where) {
+  if (name == "rgbd") return SensorType::rgbd;
+  if (name == "stereo") return SensorType::stereo;
+  if (name == "monocular") {
+    throw Error(where + ": monocular is not supported yet (issue #16); use rgbd or stereo");
+  }
+  throw Error(where + ": must be rgbd or stereo, got '" + name + "'");
+}
+
+std::string to_string(SensorType type) { return type == SensorType::stereo ? "stereo" : "rgbd"; }
+
 SystemConfig load_config(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw Error(file.string() + ": config file not found");
   YAML::Node root;
@@ -111,6 +170,8 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   const PinholeCamera& p = config.camera.pinhole;
   out << YAML::Key << "name" << YAML::Value << config.camera.name;
+  const bool stereo = config.camera.type == SensorType::stereo;
+  if (stereo) out << YAML::Key << "type" << YAML::Value << "stereo";
   out << YAML::Key << "width" << YAML::Value << p.width;
   out << YAML::Key << "height" << YAML::Value << p.height;
   out << YAML::Key << "fx" << YAML::Value << p.fx;
@@ -120,12 +181,19 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
       << std::vector<double>(p.distortion.begin(), p.distortion.end());
   out << YAML::Key << "fps" << YAML::Value << config.camera.fps;
-  out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
-  out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
-  out << YAML::Key << "depth_noise" << YAML::Value
-      << (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1 ? "kinect_v1" : "none");
-  out << YAML::Key << "depth_noise_scale" << YAML::Value << config.camera.depth_noise_scale;
-  if (config.camera.depth_shift_x != 0 || config.camera.depth_shift_y != 0) {
+  if (stereo) {
+    out << YAML::Key << "baseline" << YAML::Value << config.camera.baseline;
+    out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
+  }
+  if (!stereo) out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
+  if (!stereo) {
+    out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
+    out << YAML::Key << "depth_noise" << YAML::Value
+        << (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1 ? "kinect_v1"
+                                                                             : "none");
+    out << YAML::Key << "depth_noise_scale" << YAML::Value << config.camera.depth_noise_scale;
+  }
+  if (!stereo && (config.camera.depth_shift_x != 0 || config.camera.depth_shift_y != 0)) {
     out << YAML::Key << "depth_registration_shift_px" << YAML::Value << YAML::Flow
         << std::vector<int>{config.camera.depth_shift_x, config.camera.depth_shift_y};
   }

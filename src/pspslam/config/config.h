@@ -7,9 +7,24 @@
 
 namespace pspslam {
 
+// What the camera delivers (key `camera.type`, default rgbd). Every difference between the
+// sensors past the config lives in one place, the per-sensor frame builder
+// (tracking/frame_builder.h). Monocular (issue #16) is rejected as not yet supported.
+enum class SensorType { rgbd, stereo };
+SensorType parse_sensor_type(const std::string& name, const std::string& where);
+std::string to_string(SensorType type);
+
 // Sensor description (YAML section `camera:`; all keys but `name` and `k3` are required).
+// rgbd needs depth_factor and depth_threshold; stereo needs exactly one of `baseline` (metres)
+// and `bf` (fx * baseline, pixel metres) and refuses the depth-image keys; its depth_threshold is
+// optional (default 40 baselines: farther stereo depth is too coarse to make a point from one
+// view, ORB-SLAM2's rule).
 struct CameraConfig {
   std::string name = "unnamed";
+  SensorType type = SensorType::rgbd;
+  // Stereo only: distance between the centres of the rectified left and right cameras. The
+  // images are rectified (rows aligned, same intrinsics `pinhole`, no distortion).
+  double baseline = 0.0;
   PinholeCamera pinhole;
   double fps = 30.0;
   double depth_factor = 5000.0;  // depth image units per metre (5000 for TUM and Bonn)

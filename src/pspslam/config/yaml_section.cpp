@@ -18,6 +18,11 @@ bool YamlSection::contains(const std::string& key) const {
   return node_ && node_.IsMap() && node_[key];
 }
 
+std::string YamlSection::where(const std::string& key) const {
+  if (!contains(key)) return file_ + ": ";
+  return file_ + ":" + std::to_string(node_[key].Mark().line + 1) + ": ";
+}
+
 YamlSection YamlSection::section(const std::string& key) {
   used_.insert(key);
   const YAML::Node child = node_ && node_.IsMap() ? node_[key] : YAML::Node();

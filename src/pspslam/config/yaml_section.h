@@ -19,6 +19,8 @@ class YamlSection {
   YamlSection(const YAML::Node& node, std::string file, std::string path);
 
   bool contains(const std::string& key) const;
+  // "<file>:<line>: " of a key that is present ("<file>: " when it is not).
+  std::string where(const std::string& key) const;
 
   template <typename T>
   T required(const std::string& key) {

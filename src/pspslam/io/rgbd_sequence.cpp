@@ -1,5 +1,9 @@
 #include "pspslam/io/rgbd_sequence.h"
 
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdio>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <ostream>
@@ -132,7 +136,7 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
   std::vector<FrameFiles> associated;
   std::vector<std::string> listed_files;  // every listed file, in listing order
   const std::filesystem::path associations = dir / "associations.txt";
-  if (std::filesystem::exists(associations)) {
+  if (!options.stereo && std::filesystem::exists(associations)) {
     associated = read_associations(associations);
     sequence.used_associations_file_ = true;
     sequence.listed_rgb_ = sequence.listed_depth_ = associated.size();
@@ -142,11 +146,14 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
     }
   } else {
     const std::filesystem::path rgb_list = dir / "rgb.txt";
-    const std::filesystem::path depth_list = dir / "depth.txt";
+    const std::filesystem::path depth_list = dir / (options.stereo ? "right.txt" : "depth.txt");
     for (const auto& list : {rgb_list, depth_list}) {
       if (!std::filesystem::exists(list)) {
         throw Error(dir.string() + ": no " + list.filename().string() +
-                    " (a TUM RGB-D sequence needs rgb.txt and depth.txt, or associations.txt)");
+                    (options.stereo
+                         ? " (a stereo sequence in TUM layout needs rgb.txt and right.txt)"
+                         : " (a TUM RGB-D sequence needs rgb.txt and depth.txt, or "
+                           "associations.txt)"));
       }
     }
     const std::vector<ListedFile> rgb = read_file_list(rgb_list);
@@ -171,6 +178,27 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
     }
   }
 
+  sequence.keep_present_frames(std::move(associated), listed_files);
+  if (sequence.frames_.empty()) {
+    throw Error(dir.string() + ": no " + (options.stereo ? "stereo" : "RGB-D") +
+                " frame: " + std::to_string(sequence.listed_rgb_) + " colour and " +
+                std::to_string(sequence.listed_depth_) + (options.stereo ? " right" : " depth") +
+                " files listed, none associated within " + std::to_string(options.max_difference) +
+                " s with both files present");
+  }
+
+  const std::filesystem::path ground_truth = dir / "groundtruth.txt";
+  if (std::filesystem::exists(ground_truth)) {
+    sequence.ground_truth_ = read_tum_trajectory(ground_truth);
+  }
+  return sequence;
+}
+
+void RgbdSequence::keep_present_frames(std::vector<FrameFiles> associated,
+                                       const std::vector<std::string>& listed_files) {
+  RgbdSequence& sequence = *this;
+  const std::filesystem::path& dir = dir_;
+  const SequenceOptions& options = options_;
   // A listed name the file system cannot even look up (too long, say) is a missing file, not an
   // exception (found by fuzz/fuzz_sequence_lists).
   const auto present = [&](const std::string& file) {
@@ -196,17 +224,212 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
                         " frames (first: " + first_missing + ")";
     if (options.warnings != nullptr) *options.warnings << "warning: " << sequence.warning_ << "\n";
   }
-  if (sequence.frames_.empty()) {
-    throw Error(dir.string() + ": no RGB-D frame: " + std::to_string(sequence.listed_rgb_) +
-                " colour and " + std::to_string(sequence.listed_depth_) +
-                " depth files listed, none associated within " +
-                std::to_string(options.max_difference) + " s with both files present");
-  }
+}
 
-  const std::filesystem::path ground_truth = dir / "groundtruth.txt";
-  if (std::filesystem::exists(ground_truth)) {
-    sequence.ground_truth_ = read_tum_trajectory(ground_truth);
+std::string to_string(SequenceLayout layout) {
+  switch (layout) {
+    case SequenceLayout::kitti:
+      return "kitti";
+    case SequenceLayout::euroc:
+      return "euroc";
+    case SequenceLayout::tum:
+      break;
   }
+  return "tum";
+}
+
+namespace {
+
+// cam0/data.csv or cam1/data.csv: `timestamp_ns,filename` rows (header comment skipped).
+std::vector<ListedFile> read_euroc_list(const std::filesystem::path& file,
+                                        const std::string& folder) {
+  if (!std::filesystem::exists(file)) throw Error(file.string() + ": not found");
+  std::vector<ListedFile> list;
+  for_each_data_line(file, "EuRoC image list", [&](const TextLine& line) {
+    if (line.fields.size() != 2) {
+      throw Error(line_prefix(file, line.line) + "expected 'timestamp [ns],filename', got " +
+                  std::to_string(line.fields.size()) + " fields");
+    }
+    const double ns = parse_number(line.fields[0], file, line.line, "timestamp");
+    list.push_back({ns * 1e-9, folder + "/data/" + std::string(line.fields[1])});
+  });
+  return list;
+}
+
+// state_groundtruth_estimate0/data.csv: timestamp, p_RS_R (3), q_RS (w x y z), then velocities
+// and biases; the body pose T_world_body.
+Trajectory read_euroc_ground_truth(const std::filesystem::path& file, const Pose& T_body_camera) {
+  Trajectory trajectory;
+  for_each_data_line(file, "EuRoC ground truth", [&](const TextLine& line) {
+    if (line.fields.size() < 8) {
+      throw Error(line_prefix(file, line.line) +
+                  "expected 'timestamp, p x y z, q w x y z, ...', got " +
+                  std::to_string(line.fields.size()) + " fields");
+    }
+    double v[8];
+    for (size_t k = 0; k < 8; ++k) v[k] = parse_number(line.fields[k], file, line.line, "value");
+    const Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
+    if (std::abs(q.norm() - 1.0) > 1e-3) {
+      throw Error(line_prefix(file, line.line) + "quaternion has norm " + std::to_string(q.norm()) +
+                  ", expected a unit quaternion");
+    }
+    Pose T_world_body = Pose::Identity();
+    T_world_body.linear() = q.normalized().toRotationMatrix();
+    T_world_body.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    trajectory.push_back({v[0] * 1e-9, T_world_body * T_body_camera});
+  });
+  return trajectory;
+}
+
+}  // namespace
+
+RgbdSequence RgbdSequence::open_euroc(const std::filesystem::path& dir,
+                                      const SequenceOptions& options) {
+  if (!std::filesystem::is_directory(dir)) {
+    throw Error(dir.string() + ": sequence directory not found");
+  }
+  const std::filesystem::path mav =
+      std::filesystem::exists(dir / "mav0" / "cam0") ? dir / "mav0" : dir;
+  if (!std::filesystem::exists(mav / "cam0" / "data.csv")) {
+    throw Error(dir.string() +
+                ": no mav0/cam0/data.csv (an EuRoC MAV sequence needs mav0/cam0 and mav0/cam1, "
+                "each with data.csv, data/ and sensor.yaml)");
+  }
+  RgbdSequence sequence;
+  sequence.dir_ = mav;
+  sequence.options_ = options;
+  sequence.options_.stereo = true;
+  sequence.layout_ = SequenceLayout::euroc;
+  const EurocCamera left = read_euroc_camera(mav / "cam0" / "sensor.yaml");
+  const EurocCamera right = read_euroc_camera(mav / "cam1" / "sensor.yaml");
+  sequence.rectification_ =
+      std::make_shared<const StereoRectification>(StereoRectification::compute(
+          left, right, (mav / "cam0" / "sensor.yaml").string() + " and " + "cam1/sensor.yaml"));
+  const std::vector<ListedFile> cam0 = read_euroc_list(mav / "cam0" / "data.csv", "cam0");
+  const std::vector<ListedFile> cam1 = read_euroc_list(mav / "cam1" / "data.csv", "cam1");
+  sequence.listed_rgb_ = cam0.size();
+  sequence.listed_depth_ = cam1.size();
+  std::vector<Timestamp> t0, t1;
+  std::vector<std::string> listed;
+  for (const ListedFile& f : cam0) {
+    t0.push_back(f.timestamp);
+    listed.push_back(f.file);
+  }
+  for (const ListedFile& f : cam1) {
+    t1.push_back(f.timestamp);
+    listed.push_back(f.file);
+  }
+  // The two cameras are triggered together: their stamps agree to well under a millisecond.
+  std::vector<FrameFiles> associated;
+  for (const TimestampMatch& m : associate_timestamps(t0, t1, 1e-3)) {
+    associated.push_back({cam0[m.first].timestamp, cam0[m.first].file, cam1[m.second].timestamp,
+                          cam1[m.second].file});
+  }
+  sequence.keep_present_frames(std::move(associated), listed);
+  if (sequence.frames_.empty()) {
+    throw Error(dir.string() + ": no stereo frame: " + std::to_string(cam0.size()) + " cam0 and " +
+                std::to_string(cam1.size()) +
+                " cam1 images listed, none paired within 1 ms with both files present");
+  }
+  const std::filesystem::path ground_truth = mav / "state_groundtruth_estimate0" / "data.csv";
+  if (std::filesystem::exists(ground_truth)) {
+    // The rectified left camera: x_rect = R x_cam0, so T_cam0_rect rotates by R^T.
+    Pose T_cam0_rect = Pose::Identity();
+    T_cam0_rect.linear() = sequence.rectification_->R_rect_left.transpose();
+    sequence.ground_truth_ =
+        read_euroc_ground_truth(ground_truth, left.T_body_camera * T_cam0_rect);
+  }
+  return sequence;
+}
+
+KittiCalibration read_kitti_calibration(const std::filesystem::path& file) {
+  std::optional<std::array<double, 12>> p0, p1;
+  size_t p0_line = 0, p1_line = 0;
+  for_each_data_line(file, "KITTI calibration", [&](const TextLine& line) {
+    const std::string_view name = line.fields[0];
+    if (name != "P0:" && name != "P1:") return;  // P2, P3, Tr: other sensors
+    if (line.fields.size() != 13) {
+      throw Error(line_prefix(file, line.line) + std::string(name) + " expected 12 numbers, got " +
+                  std::to_string(line.fields.size() - 1));
+    }
+    std::array<double, 12> p{};
+    for (size_t k = 0; k < 12; ++k) {
+      p[k] = parse_number(line.fields[k + 1], file, line.line, std::string(name.substr(0, 2)));
+    }
+    (name == "P0:" ? p0 : p1) = p;
+    (name == "P0:" ? p0_line : p1_line) = line.line;
+  });
+  if (!p0) throw Error(file.string() + ": no 'P0:' line (the left camera's projection matrix)");
+  if (!p1) throw Error(file.string() + ": no 'P1:' line (the right camera's projection matrix)");
+  KittiCalibration calibration;
+  calibration.fx = (*p0)[0];
+  calibration.cx = (*p0)[2];
+  calibration.fy = (*p0)[5];
+  calibration.cy = (*p0)[6];
+  if (!(calibration.fx > 0.0) || !(calibration.fy > 0.0)) {
+    throw Error(line_prefix(file, p0_line) + "P0 focal lengths must be > 0");
+  }
+  if (std::abs((*p1)[0] - calibration.fx) > 1e-6 * calibration.fx) {
+    throw Error(line_prefix(file, p1_line) + "P1 fx " + std::to_string((*p1)[0]) +
+                " differs from P0's " + std::to_string(calibration.fx) + ": not a rectified pair");
+  }
+  calibration.baseline = -(*p1)[3] / calibration.fx;
+  if (!(calibration.baseline > 0.0)) {
+    throw Error(line_prefix(file, p1_line) +
+                "P1 must put the right camera at a positive baseline (P1[0][3] = -fx * baseline "
+                "< 0), got P1[0][3] = " +
+                std::to_string((*p1)[3]));
+  }
+  return calibration;
+}
+
+RgbdSequence RgbdSequence::open_kitti(const std::filesystem::path& dir,
+                                      const SequenceOptions& options) {
+  if (!std::filesystem::is_directory(dir)) {
+    throw Error(dir.string() + ": sequence directory not found");
+  }
+  RgbdSequence sequence;
+  sequence.dir_ = dir;
+  sequence.options_ = options;
+  sequence.options_.stereo = true;
+  sequence.layout_ = SequenceLayout::kitti;
+  const std::filesystem::path times = dir / "times.txt";
+  if (!std::filesystem::exists(times)) {
+    throw Error(dir.string() +
+                ": no times.txt (a KITTI odometry sequence needs times.txt, "
+                "calib.txt, image_0/ and image_1/)");
+  }
+  std::vector<FrameFiles> frames;
+  std::vector<std::string> listed;
+  Timestamp previous = -std::numeric_limits<double>::infinity();
+  for_each_data_line(times, "KITTI times", [&](const TextLine& line) {
+    if (line.fields.size() != 1) {
+      throw Error(line_prefix(times, line.line) + "expected one timestamp, got " +
+                  std::to_string(line.fields.size()) + " fields");
+    }
+    const double t = parse_number(line.fields[0], times, line.line, "timestamp");
+    if (!(t > previous)) {
+      throw Error(line_prefix(times, line.line) + "timestamp " + std::string(line.fields[0]) +
+                  " does not increase");
+    }
+    previous = t;
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu.png", frames.size());
+    FrameFiles files{t, std::string("image_0/") + name, t, std::string("image_1/") + name};
+    listed.push_back(files.rgb_file);
+    listed.push_back(files.depth_file);
+    frames.push_back(std::move(files));
+  });
+  sequence.listed_rgb_ = sequence.listed_depth_ = frames.size();
+  std::vector<Timestamp> stamps;
+  for (const FrameFiles& f : frames) stamps.push_back(f.rgb_timestamp);
+  sequence.keep_present_frames(std::move(frames), listed);
+  if (sequence.frames_.empty()) {
+    throw Error(dir.string() + ": no stereo frame: " + std::to_string(sequence.listed_rgb_) +
+                " listed in times.txt, none with both image_0/ and image_1/ files present");
+  }
+  const std::filesystem::path poses = dir / "poses.txt";
+  if (std::filesystem::exists(poses)) sequence.ground_truth_ = read_kitti_trajectory(poses, stamps);
   return sequence;
 }
 
@@ -225,7 +448,27 @@ RgbdFrame RgbdSequence::load(size_t i) const {
   frame.name = files.rgb_file;
   const std::filesystem::path rgb_path = dir_ / files.rgb_file;
   const std::filesystem::path depth_path = dir_ / files.depth_file;
-  frame.bgr = read_color_image(rgb_path);
+  frame.bgr = read_color_image(rgb_path);  // KITTI's grey images load as three equal channels
+  if (options_.stereo) {
+    frame.right = cv::imread(depth_path.string(), cv::IMREAD_GRAYSCALE);
+    if (frame.right.empty()) {
+      throw Error(depth_path.string() +
+                  ": cannot read right image (missing, empty or not an image)");
+    }
+    if (frame.right.size() != frame.bgr.size()) {
+      throw Error(rgb_path.string() + " is " + std::to_string(frame.bgr.cols) + "x" +
+                  std::to_string(frame.bgr.rows) + " but " + depth_path.string() + " is " +
+                  std::to_string(frame.right.cols) + "x" + std::to_string(frame.right.rows));
+    }
+    if (rectification_) {
+      cv::Mat left, right;
+      rectification_->rectify(frame.bgr, frame.right, left, right);
+      frame.bgr = left;
+      frame.right = right;
+    }
+    if (options_.load_gray) cv::cvtColor(frame.bgr, frame.gray, cv::COLOR_BGR2GRAY);
+    return frame;
+  }
   frame.depth = read_depth_image(depth_path, options_.depth_factor, options_.depth_shift_x,
                                  options_.depth_shift_y);
   if (frame.bgr.size() != frame.depth.size()) {

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/io/association.h"
+#include "pspslam/io/euroc.h"
 
 namespace pspslam {
 
@@ -27,7 +29,18 @@ struct SequenceOptions {
   std::ostream* warnings = &std::cerr;
   // RgbdFrame::gray is filled only when asked (saves a colour conversion per frame).
   bool load_gray = true;
+  // A rectified stereo pair per frame instead of colour + depth: the TUM-style lists are
+  // rgb.txt (left) and right.txt (right, CV_8UC1 in RgbdFrame::right); no depth is read.
+  bool stereo = false;
 };
+
+// How a sequence folder is laid out (detected by open_sequence_with_config).
+enum class SequenceLayout {
+  tum,    // rgb.txt + depth.txt or associations.txt (or rgb.txt + right.txt for stereo)
+  kitti,  // KITTI odometry: times.txt, calib.txt, image_0/, image_1/, optional poses.txt
+  euroc,  // EuRoC MAV: mav0/cam0, mav0/cam1 (data.csv, data/, sensor.yaml), unrectified
+};
+std::string to_string(SequenceLayout layout);
 
 // One associated colour/depth frame in memory.
 struct RgbdFrame {
@@ -36,7 +49,8 @@ struct RgbdFrame {
   Timestamp depth_timestamp = 0.0;
   cv::Mat bgr;    // CV_8UC3
   cv::Mat gray;   // CV_8UC1 (empty unless SequenceOptions::load_gray)
-  cv::Mat depth;  // CV_32FC1 metres, 0 = no reading
+  cv::Mat depth;  // CV_32FC1 metres, 0 = no reading (empty for a stereo pair)
+  cv::Mat right;  // stereo only: the rectified right image, CV_8UC1 (empty for RGB-D)
   // The colour image's file relative to its sequence ("rgb/1.5.png"); per-frame pictures are
   // named after it. A live camera frame is named as `pspslam record` would store it.
   std::string name;
@@ -45,10 +59,20 @@ struct RgbdFrame {
 // File names of one associated frame, relative to the sequence directory as listed.
 struct FrameFiles {
   Timestamp rgb_timestamp = 0.0;
-  std::string rgb_file;
+  std::string rgb_file;  // colour, or the left image of a stereo pair
   Timestamp depth_timestamp = 0.0;
-  std::string depth_file;
+  std::string depth_file;  // depth, or the right image of a stereo pair
 };
+
+// KITTI odometry calibration (calib.txt): the rectified left camera (P0) and the baseline from
+// P1's translation (P1[0][3] = -fx * baseline).
+struct KittiCalibration {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  double baseline = 0.0;
+};
+// Errors name file:line: "P0: expected 12 numbers, got N", a non-number, a missing P0 or P1,
+// a P1 whose fx differs from P0's (not a rectified pair), a baseline that is not positive.
+KittiCalibration read_kitti_calibration(const std::filesystem::path& file);
 
 // An RGB-D sequence in the TUM RGB-D layout (also used by the Bonn dataset):
 //   rgb.txt, depth.txt  `timestamp filename` lists, associated like associate.py, or
@@ -64,6 +88,22 @@ class RgbdSequence {
   // associations.txt", malformed lines ("<file>:<line>: expected 'timestamp filename', got N
   // fields", ...), a malformed groundtruth.txt, no frame left.
   static RgbdSequence open(const std::filesystem::path& dir, const SequenceOptions& options = {});
+  // KITTI odometry layout (stereo): times.txt (one timestamp in seconds per line), image_0/ and
+  // image_1/ (left and right, %06d.png, one per line of times.txt), and optionally poses.txt
+  // (KITTI's 3x4 row-major camera-to-world per line, one per frame) as ground truth. Missing
+  // image files are counted and their frames skipped with one warning, as for TUM.
+  static RgbdSequence open_kitti(const std::filesystem::path& dir,
+                                 const SequenceOptions& options = {});
+  // EuRoC MAV layout (stereo): DIR/mav0 (or DIR itself when it is mav0) with cam0/ and cam1/,
+  // each data.csv (`#timestamp [ns],filename`), data/<file> and sensor.yaml. The pair is
+  // rectified from the two sensor.yaml (cv::stereoRectify + remap) as frames load; cam0 and cam1
+  // rows are paired by equal timestamps. Ground truth, when
+  // mav0/state_groundtruth_estimate0/data.csv exists, is moved from the body (IMU) onto the
+  // rectified left camera. Missing image files are counted once and their frames skipped.
+  static RgbdSequence open_euroc(const std::filesystem::path& dir,
+                                 const SequenceOptions& options = {});
+  // The rectification of an EuRoC pair (null for rectified layouts).
+  const std::shared_ptr<const StereoRectification>& rectification() const { return rectification_; }
 
   size_t size() const { return frames_.size(); }
   bool empty() const { return frames_.empty(); }
@@ -83,6 +123,9 @@ class RgbdSequence {
   // groundtruth.txt when present.
   const std::optional<Trajectory>& ground_truth() const { return ground_truth_; }
 
+  SequenceLayout layout() const { return layout_; }
+  bool stereo() const { return options_.stereo; }
+
   // Book-keeping of open(), for reports.
   bool used_associations_file() const { return used_associations_file_; }
   size_t listed_rgb() const { return listed_rgb_; }
@@ -94,11 +137,16 @@ class RgbdSequence {
 
  private:
   RgbdSequence() = default;
+  // Keeps the frames whose files all exist; counts the missing listed files once and warns.
+  void keep_present_frames(std::vector<FrameFiles> associated,
+                           const std::vector<std::string>& listed_files);
 
   std::filesystem::path dir_;
   SequenceOptions options_;
   std::vector<FrameFiles> frames_;
   std::optional<Trajectory> ground_truth_;
+  SequenceLayout layout_ = SequenceLayout::tum;
+  std::shared_ptr<const StereoRectification> rectification_;
   bool used_associations_file_ = false;
   size_t listed_rgb_ = 0;
   size_t listed_depth_ = 0;

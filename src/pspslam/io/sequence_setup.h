@@ -23,9 +23,21 @@ struct SequenceSetup {
 //    does not exist (pass a preset, e.g. --config config/bonn.yaml)";
 //  - the sequence is opened with the config's depth factor; the missing-files warning goes to
 //    `warnings`.
+//  - `sensor` (`pspslam run --sensor`) overrides the config's camera.type;
+//  - a KITTI odometry folder (times.txt + calib.txt) is read as such: its camera is P0 of
+//    calib.txt with P1's baseline, its size that of the first left image, its rate from
+//    times.txt; the config (when given) supplies everything else (ORB) and its camera
+//    intrinsics are replaced by the calibration's.
 SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
                                         const std::optional<std::filesystem::path>& config_file,
-                                        std::ostream* warnings = &std::cerr);
+                                        std::ostream* warnings = &std::cerr,
+                                        std::optional<SensorType> sensor = std::nullopt);
+
+// The camera.type a config is run as when `--sensor` says `sensor`. Switching needs what the
+// other sensor needs: "--sensor stereo: <file> gives no camera.baseline" (stereo needs a
+// baseline), "--sensor rgbd: <file> describes a stereo camera (no depth_factor)".
+void apply_sensor_override(SystemConfig& config, SensorType sensor,
+                           const std::filesystem::path& config_file);
 
 // Multi-line summary: frames, skipped frames, time span, ground truth, config.
 std::string describe_sequence(const SequenceSetup& setup);

@@ -1,6 +1,8 @@
 #include "pspslam/io/trajectory_io.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <fstream>
 
 #include <charconv>
 #include <cmath>
@@ -160,6 +162,55 @@ void TrajectoryWriter::write(const StampedPose& pose) {
   stream_.flush();
   if (!stream_) throw Error(path_.string() + ": cannot write trajectory file (disk full?)");
   ++count_;
+}
+
+Trajectory read_kitti_trajectory(const std::filesystem::path& file,
+                                 const std::vector<Timestamp>& timestamps) {
+  Trajectory trajectory;
+  for_each_data_line(file, "KITTI poses", [&](const TextLine& line) {
+    if (line.fields.size() != 12) {
+      throw Error(line_prefix(file, line.line) + "expected 12 numbers (3x4 pose, row-major), got " +
+                  std::to_string(line.fields.size()));
+    }
+    if (trajectory.size() >= timestamps.size()) {
+      throw Error(line_prefix(file, line.line) + "more poses than the " +
+                  std::to_string(timestamps.size()) + " timestamps of times.txt");
+    }
+    Eigen::Matrix<double, 3, 4> m;
+    for (int k = 0; k < 12; ++k) {
+      m(k / 4, k % 4) =
+          parse_number(line.fields[static_cast<size_t>(k)], file, line.line, "pose entry");
+    }
+    const Eigen::Matrix3d r = m.leftCols<3>();
+    if (!(r * r.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-3)) {
+      throw Error(line_prefix(file, line.line) + "the rotation is not orthonormal");
+    }
+    Pose pose = Pose::Identity();
+    pose.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
+    pose.translation() = m.col(3);
+    trajectory.push_back({timestamps[trajectory.size()], pose});
+  });
+  if (trajectory.size() != timestamps.size()) {
+    throw Error(file.string() + ": " + std::to_string(trajectory.size()) + " poses for " +
+                std::to_string(timestamps.size()) + " timestamps in times.txt");
+  }
+  return trajectory;
+}
+
+void write_kitti_trajectory(const std::filesystem::path& file, const Trajectory& trajectory) {
+  std::ofstream out(file);
+  if (!out) throw Error(file.string() + ": cannot write trajectory file");
+  char line[512];
+  for (const StampedPose& stamped : trajectory) {
+    // + 0.0 turns -0 into 0: the same pose always prints the same bytes.
+    const Eigen::Matrix4d m = stamped.T_world_camera.matrix().array() + 0.0;
+    std::snprintf(line, sizeof(line),
+                  "%.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e %.9e\n", m(0, 0), m(0, 1),
+                  m(0, 2), m(0, 3), m(1, 0), m(1, 1), m(1, 2), m(1, 3), m(2, 0), m(2, 1), m(2, 2),
+                  m(2, 3));
+    out << line;
+  }
+  if (!out) throw Error(file.string() + ": failed writing trajectory file");
 }
 
 }  // namespace pspslam

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "pspslam/core/types.h"
 
@@ -42,6 +43,15 @@ inline constexpr const char* kTrajectoryHeader =
 
 // Writes a whole trajectory at once (header + one line per pose).
 void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory);
+
+// KITTI odometry poses: one camera-to-world pose per line as 12 numbers, the 3x4 matrix
+// [R | t] row by row. KITTI files carry no timestamps: read_kitti_trajectory pairs line i with
+// timestamps[i] (times.txt) and needs as many lines as timestamps. Errors name file:line (field
+// count, non-numbers, a rotation not orthonormal within 1e-3, too few or too many lines).
+Trajectory read_kitti_trajectory(const std::filesystem::path& file,
+                                 const std::vector<Timestamp>& timestamps);
+// Writes `trajectory` in that format (timestamps dropped, poses in the order given).
+void write_kitti_trajectory(const std::filesystem::path& file, const Trajectory& trajectory);
 
 // Writes poses one at a time as they are computed. Every write() reaches the operating system
 // before it returns (flush), so if the process is interrupted or killed the file still holds a

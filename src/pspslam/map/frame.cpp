@@ -45,6 +45,22 @@ Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> ke
   outlier.assign(n, 0);
 }
 
+Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
+             cv::Mat descriptors, std::vector<float> depth, std::vector<float> right_u,
+             std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid)
+    : id_(id),
+      timestamp_(timestamp),
+      keypoints_(std::move(keypoints)),
+      descriptors_(std::move(descriptors)),
+      depth_(std::move(depth)),
+      right_u_(std::move(right_u)),
+      camera_(std::move(camera)),
+      pyramid_(std::move(pyramid)) {
+  grid_ = FeatureGrid(keypoints_, camera_->min_x, camera_->max_x, camera_->min_y, camera_->max_y);
+  map_points.assign(keypoints_.size(), nullptr);
+  outlier.assign(keypoints_.size(), 0);
+}
+
 void Frame::set_pose(const Pose& T_camera_world) { T_camera_world_ = T_camera_world; }
 
 Eigen::Vector3d Frame::unproject_camera(int i) const {

@@ -28,6 +28,12 @@ class Frame {
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
         cv::Mat descriptors, const cv::Mat& depth_metres, std::shared_ptr<const RgbdCamera> camera,
         std::shared_ptr<const ScalePyramid> pyramid);
+  // A frame whose depth was measured per keypoint (a rectified stereo pair: depth and right
+  // coordinate from match/stereo_matcher.h; depth <= 0 and NaN where a keypoint has no partner).
+  // Keypoints are in the rectified image, which has no distortion.
+  Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
+        cv::Mat descriptors, std::vector<float> depth, std::vector<float> right_u,
+        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid);
 
   std::uint64_t id() const { return id_; }
   Timestamp timestamp() const { return timestamp_; }

@@ -8,7 +8,9 @@ namespace pspslam {
 RgbdCamera RgbdCamera::from_config(const CameraConfig& camera, double virtual_baseline) {
   RgbdCamera c;
   c.pinhole = camera.pinhole;
-  c.bf = camera.pinhole.fx * virtual_baseline;
+  // A stereo pair has a real baseline: its right coordinate is measured, not derived from depth.
+  c.bf =
+      camera.pinhole.fx * (camera.type == SensorType::stereo ? camera.baseline : virtual_baseline);
   c.depth_threshold = camera.depth_threshold;
   const double w = camera.pinhole.width;
   const double h = camera.pinhole.height;

@@ -18,7 +18,8 @@ struct RgbdCamera {
   double min_y = 0.0;
   double max_y = 0.0;
 
-  // `virtual_baseline` in metres (ORB-SLAM2 uses 0.08 for Kinect-class sensors).
+  // `virtual_baseline` in metres (ORB-SLAM2 uses 0.08 for Kinect-class sensors); a stereo
+  // camera uses its config's real baseline instead.
   static RgbdCamera from_config(const CameraConfig& camera, double virtual_baseline);
 
   bool in_bounds(double u, double v) const {

@@ -26,6 +26,9 @@ struct RunOutputs {
   // image: the final dynamic mask (8-bit PNG, 255 = dynamic) and the keypoint overlay.
   std::filesystem::path masks;
   std::filesystem::path overlays;
+  // `--trajectory-format kitti`: also write trajectory_refined_kitti.txt (KITTI odometry format,
+  // 3x4 row-major camera-to-world per tracked frame, in frame order).
+  bool kitti_trajectory = false;
 };
 
 // Checks every output path and creates the folders (core/output_paths.h) before any work, so a
@@ -37,6 +40,8 @@ struct RunOptions {
   std::filesystem::path sequence;  // read by SequenceRunner(RunOptions, ...) only
   // Config YAML; none: SEQUENCE/config.yaml (io/sequence_setup.h).
   std::optional<std::filesystem::path> config;
+  // `pspslam run --sensor`: overrides the config's camera.type (io/sequence_setup.h).
+  std::optional<SensorType> sensor;
   size_t max_frames = 0;  // 0 = all
   // Frames fed as black images without depth: tracking is really lost (relocalisation tests).
   std::optional<FrameRange> blackout;

@@ -44,9 +44,9 @@ void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, c
 }  // namespace
 
 RunInput open_sequence_input(const RunOptions& options) {
-  SequenceSetup setup =
-      open_sequence_with_config(options.sequence, options.config,
-                                spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr);
+  SequenceSetup setup = open_sequence_with_config(
+      options.sequence, options.config,
+      spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr, options.sensor);
   RunInput input{setup.config_file, setup.config, nullptr};
   input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
                                                   options.system.dynamic.realtime);
@@ -106,6 +106,7 @@ std::optional<RgbdFrame> SequenceRunner::next_frame() {
     loaded->bgr.setTo(cv::Scalar::all(0));
     if (!loaded->gray.empty()) loaded->gray.setTo(cv::Scalar::all(0));
     loaded->depth.setTo(cv::Scalar::all(0));
+    if (!loaded->right.empty()) loaded->right.setTo(cv::Scalar::all(0));
   }
   if (options_.blackout && !blackout_return_ && loaded->index >= options_.blackout->end())
     blackout_return_ = loaded->timestamp;
@@ -212,6 +213,8 @@ void SequenceRunner::finish(double seconds) {
   write_tum_trajectory(out_dir / "keyframes.txt", system_->keyframe_trajectory());
   const Trajectory refined = system_->refined_trajectory();
   write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
+  if (options_.outputs.kitti_trajectory)
+    write_kitti_trajectory(out_dir / "trajectory_refined_kitti.txt", refined);
   const MappingStats mapping = system_->mapping_stats();
   if (exporter_) write_map_exports(options_.outputs, *exporter_, system_->map(), out_);
   write_run_report({.options = options_,

@@ -199,6 +199,13 @@ void SynthOptions::validate() const {
     throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
   if (!(loop_turns > 0.0 && loop_turns <= 10.0))
     throw Error("synth: flag --loop-turns must be in (0, 10], got " + std::to_string(loop_turns));
+  if (!(stereo_baseline >= 0.0 && stereo_baseline <= 2.0))
+    throw Error("synth: flag --stereo must be a baseline in metres in (0, 2], got " +
+                std::to_string(stereo_baseline));
+  if (stereo_baseline > 0.0 && sensor == SynthSensor::kKinect)
+    throw Error("synth: flag --stereo renders the ideal sensor only (not --sensor kinect)");
+  if (layout != Layout::tum && stereo_baseline <= 0.0)
+    throw Error("synth: flag --layout kitti|euroc needs --stereo BASELINE_M (stereo layouts)");
 }
 
 CameraConfig synthetic_camera_config() {
@@ -231,6 +238,7 @@ struct SyntheticScene::Impl {
   explicit Impl(const SynthOptions& opts);
   void render(size_t index, SynthFrame& frame, int threads) const;
   void render_kinect(size_t index, SynthFrame& frame, int threads) const;
+  void render_right(size_t index, cv::Mat& bgr, int threads) const;
   // Every box posed at scene time t (seconds) as seen from T_world_camera.
   void prepare_boxes(double t, const Pose& T_world_camera, std::vector<FrameBox>& boxes) const;
   // Ray casts and shades rows [row_begin, row_end) into the (allocated) images.
@@ -608,6 +616,21 @@ void SyntheticScene::Impl::render(size_t index, SynthFrame& frame, int threads) 
   }
 }
 
+void SyntheticScene::Impl::render_right(size_t index, cv::Mat& bgr, int threads) const {
+  const double t = static_cast<double>(index) / kFps;
+  const Pose T_world_right =
+      camera_path.T_world_camera(t) * Eigen::Translation3d(options.stereo_baseline, 0.0, 0.0);
+  std::vector<FrameBox> boxes;
+  prepare_boxes(t, T_world_right, boxes);
+  const int width = camera.width, height = camera.height;
+  bgr.create(height, width, CV_8UC3);
+  cv::Mat depth(height, width, CV_32F), labels(height, width, CV_8U);
+  cv::Mat surface_ids(height, width, CV_16U), incidence_cos(height, width, CV_32F);
+  parallel_rows(height, threads, [&](int row_begin, int row_end) {
+    draw_rows(boxes, row_begin, row_end, bgr, depth, labels, surface_ids, incidence_cos);
+  });
+}
+
 void SyntheticScene::Impl::render_kinect(size_t index, SynthFrame& frame, int threads) const {
   const synth::KinectFaults& faults = options.faults;
   const double t = static_cast<double>(index) / kFps;
@@ -716,6 +739,17 @@ void SyntheticScene::render(size_t index, SynthFrame& frame, int threads) const 
   impl_->render(index, frame, resolve_threads(threads));
 }
 
+void SyntheticScene::render_right(size_t index, cv::Mat& bgr, int threads) const {
+  if (!(impl_->options.stereo_baseline > 0.0)) {
+    throw Error("synth: render_right needs a stereo baseline (--stereo)");
+  }
+  if (index >= impl_->options.frames) {
+    throw Error("synth: frame index " + std::to_string(index) + " is past the sequence end (" +
+                std::to_string(impl_->options.frames) + " frames)");
+  }
+  impl_->render_right(index, bgr, resolve_threads(threads));
+}
+
 const PinholeCamera& SyntheticScene::camera() const { return impl_->camera; }
 const SynthOptions& SyntheticScene::options() const { return impl_->options; }
 size_t SyntheticScene::frame_count() const { return impl_->options.frames; }
@@ -744,9 +778,21 @@ Pose SyntheticScene::ground_truth_pose(size_t index) const {
   return camera_pose(index) * impl_->T_body_camera.inverse();
 }
 
-SystemConfig SyntheticScene::system_config() const {
+SystemConfig SyntheticScene::rgbd_system_config() const {
   SystemConfig config = synthetic_system_config();
   if (impl_->distortion) config.camera.pinhole.distortion = synth::kKinectDistortion;
+  return config;
+}
+
+SystemConfig SyntheticScene::system_config() const {
+  SystemConfig config = rgbd_system_config();
+  const double baseline = impl_->options.stereo_baseline;
+  if (baseline > 0.0) {
+    config.camera.name = "synthetic_stereo";
+    config.camera.type = SensorType::stereo;
+    config.camera.baseline = baseline;
+    config.camera.depth_threshold = 40.0 * baseline;
+  }
   return config;
 }
 

@@ -48,6 +48,13 @@ struct SynthOptions {
   SynthSensor sensor = SynthSensor::kIdeal;
   synth::KinectFaults faults;  // used with sensor == kKinect only (depth_noise is then ignored)
   int threads = 0;             // worker threads for rendering / writing; 0 = all hardware threads
+  // `--stereo BASELINE_M`: also render a rectified right camera this far along the left
+  // camera's x axis (same intrinsics, same instant); 0 = RGB-D only. Ideal sensor only.
+  double stereo_baseline = 0.0;
+  // `--layout kitti|euroc` (needs stereo): write the KITTI odometry or EuRoC MAV layout
+  // instead of TUM's.
+  enum class Layout { tum, kitti, euroc };
+  Layout layout = Layout::tum;
 
   // Throws pspslam::Error naming the offending CLI flag (--frames, --bodies, ...).
   void validate() const;
@@ -77,6 +84,9 @@ class SyntheticScene {
   SyntheticScene& operator=(SyntheticScene&&) noexcept;
 
   SynthFrame render(size_t index) const;
+  // The rectified right image of frame `index` (options().stereo_baseline > 0): the scene at the
+  // same instant seen from T_world_camera * (baseline, 0, 0), same intrinsics. CV_8UC3.
+  void render_right(size_t index, cv::Mat& bgr, int threads) const;
   // Same, reusing `frame`'s buffers; `threads` overrides options().threads (1 = this thread).
   void render(size_t index, SynthFrame& frame, int threads) const;
 
@@ -95,8 +105,11 @@ class SyntheticScene {
   Pose T_body_camera() const;
   Pose ground_truth_pose(size_t index) const;
   // config.yaml of the sequence: synthetic_system_config() plus the lens distortion when the
-  // kinect distortion fault is on.
+  // kinect distortion fault is on; a stereo camera (type stereo, the baseline, depth threshold
+  // 40 baselines) with --stereo.
   SystemConfig system_config() const;
+  // The RGB-D config of the same sequence (config_rgbd.yaml beside a stereo config.yaml).
+  SystemConfig rgbd_system_config() const;
 
  private:
   struct Impl;

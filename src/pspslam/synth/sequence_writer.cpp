@@ -2,17 +2,20 @@
 
 #include <Eigen/Geometry>
 #include <atomic>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <thread>
 #include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
+#include "pspslam/io/trajectory_io.h"
 
 namespace pspslam {
 namespace {
@@ -56,12 +59,22 @@ std::string kinect_flags(const SynthOptions& options) {
   return flags;
 }
 
+std::string stereo_flags(const SynthOptions& options) {
+  if (!(options.stereo_baseline > 0.0)) return "";
+  char text[64];
+  std::snprintf(text, sizeof(text), " --stereo %g", options.stereo_baseline);
+  const char* layout = options.layout == SynthOptions::Layout::kitti   ? " --layout kitti"
+                       : options.layout == SynthOptions::Layout::euroc ? " --layout euroc"
+                                                                       : "";
+  return std::string(text) + layout;
+}
+
 std::string describe(const SynthOptions& options) {
   return "pspslam synth --frames " + std::to_string(options.frames) + " --bodies " +
          std::to_string(options.bodies) + " --seed " + std::to_string(options.seed) +
          " --trajectory " + to_string(options.trajectory) + " --depth-noise " +
          (options.depth_noise ? "on" : "off") + " --carried-objects " +
-         std::to_string(options.carried_objects) + kinect_flags(options);
+         std::to_string(options.carried_objects) + kinect_flags(options) + stereo_flags(options);
 }
 
 void write_frame_list(const fs::path& dir, const std::string& list_name, const std::string& folder,
@@ -167,6 +180,96 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
   close_text(out, file);
 }
 
+// KITTI odometry files: times.txt, calib.txt (P0 left, P1 right at the baseline; P2, P3 copies
+// of them since the synthetic rig has no colour cameras of its own), poses.txt (3x4 row-major
+// camera-to-world per frame).
+void write_kitti_files(const fs::path& dir, const SyntheticScene& scene) {
+  {
+    const fs::path file = dir / "times.txt";
+    std::ofstream out = open_text(file);
+    // The synthetic timestamps as they are (KITTI's start at 0): the same stamps as the TUM
+    // layout, so both layouts' trajectories compare with one ground truth.
+    for (size_t i = 0; i < scene.frame_count(); ++i)
+      out << format_timestamp(scene.timestamp(i)) << "\n";
+    close_text(out, file);
+  }
+  {
+    const fs::path file = dir / "calib.txt";
+    std::ofstream out = open_text(file);
+    const PinholeCamera& c = scene.camera();
+    const double bf = c.fx * scene.options().stereo_baseline;
+    char line[512];
+    for (int k = 0; k < 4; ++k) {
+      const double tx = k % 2 == 1 ? -bf : 0.0;
+      std::snprintf(line, sizeof(line),
+                    "P%d: %.12e 0.000000000000e+00 %.12e %.12e 0.000000000000e+00 %.12e %.12e "
+                    "0.000000000000e+00 0.000000000000e+00 0.000000000000e+00 1.000000000000e+00 "
+                    "0.000000000000e+00\n",
+                    k, c.fx, c.cx, tx, c.fy, c.cy);
+      out << line;
+    }
+    close_text(out, file);
+  }
+  write_kitti_trajectory(dir / "poses.txt", scene.ground_truth());
+}
+
+std::string euroc_stamp(Timestamp t) {
+  return std::to_string(static_cast<long long>(std::llround(t * 1e9)));
+}
+
+// EuRoC MAV files: cam0 and cam1 (data.csv, sensor.yaml: the synthetic intrinsics, no
+// distortion, cam0 at the body origin and cam1 at (baseline, 0, 0), so rectification is the
+// identity) and the body's ground truth (= cam0's pose).
+void write_euroc_files(const fs::path& dir, const SyntheticScene& scene) {
+  const PinholeCamera& c = scene.camera();
+  for (int cam = 0; cam < 2; ++cam) {
+    const fs::path folder = dir / "mav0" / ("cam" + std::to_string(cam));
+    {
+      const fs::path file = folder / "data.csv";
+      std::ofstream out = open_text(file);
+      out << "#timestamp [ns],filename\n";
+      for (size_t i = 0; i < scene.frame_count(); ++i) {
+        const std::string stamp = euroc_stamp(scene.timestamp(i));
+        out << stamp << "," << stamp << ".png\n";
+      }
+      close_text(out, file);
+    }
+    const fs::path file = folder / "sensor.yaml";
+    std::ofstream out = open_text(file);
+    char text[1024];
+    std::snprintf(text, sizeof(text),
+                  "%%YAML:1.0\nsensor_type: camera\ncomment: pspslam synth cam%d\nT_BS:\n"
+                  "  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, %.9f, 0.0, 1.0, 0.0, 0.0,\n"
+                  "         0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\nrate_hz: 30\n"
+                  "resolution: [%d, %d]\ncamera_model: pinhole\n"
+                  "intrinsics: [%.9f, %.9f, %.9f, %.9f]\n"
+                  "distortion_model: radial-tangential\n"
+                  "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n",
+                  cam, cam == 1 ? scene.options().stereo_baseline : 0.0, c.width, c.height, c.fx,
+                  c.fy, c.cx, c.cy);
+    out << text;
+    close_text(out, file);
+  }
+  const fs::path file = dir / "mav0/state_groundtruth_estimate0/data.csv";
+  std::ofstream out = open_text(file);
+  out << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+         "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad "
+         "s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m "
+         "s^-2], b_a_RS_S_z [m s^-2]\n";
+  char line[512];
+  for (size_t i = 0; i < scene.frame_count(); ++i) {
+    const Pose pose = scene.ground_truth_pose(i);
+    Eigen::Quaterniond q(pose.linear());
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    const Eigen::Vector3d t = pose.translation();
+    std::snprintf(line, sizeof(line), "%s,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,0,0,0,0,0,0,0,0,0\n",
+                  euroc_stamp(scene.timestamp(i)).c_str(), t.x(), t.y(), t.z(), q.w(), q.x(), q.y(),
+                  q.z());
+    out << line;
+  }
+  close_text(out, file);
+}
+
 }  // namespace
 
 std::string format_timestamp(Timestamp timestamp) {
@@ -187,7 +290,14 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
     throw Error("synth: --out " + dir.string() + " exists and is not a directory");
   }
-  for (const char* sub : {"rgb", "depth", "mask"}) {
+  const bool stereo = scene.options().stereo_baseline > 0.0;
+  const bool kitti = scene.options().layout == SynthOptions::Layout::kitti;
+  const bool euroc = scene.options().layout == SynthOptions::Layout::euroc;
+  std::vector<const char*> folders = {"rgb", "depth", "mask"};
+  if (stereo) folders.push_back("right");
+  if (kitti) folders = {"image_0", "image_1"};
+  if (euroc) folders = {"mav0/cam0/data", "mav0/cam1/data", "mav0/state_groundtruth_estimate0"};
+  for (const char* sub : folders) {
     fs::create_directories(dir / sub, ec);
     if (ec) throw Error("synth: cannot create " + (dir / sub).string() + ": " + ec.message());
   }
@@ -209,15 +319,36 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
 
   const auto worker = [&] {
     SynthFrame frame;
-    cv::Mat depth_u16;
+    cv::Mat depth_u16, right, gray;
     for (size_t i = next++; i < frames && !failed; i = next++) {
       try {
         scene.render(i, frame, 1);
-        const std::string name = format_timestamp(frame.timestamp) + ".png";
-        write_png(dir / "rgb" / name, frame.bgr);
-        frame.depth_sensor.convertTo(depth_u16, CV_16U, 5000.0);
-        write_png(dir / "depth" / name, depth_u16);
-        write_png(dir / "mask" / name, frame.labels);
+        if (stereo) {
+          scene.render_right(i, right, 1);
+          cv::cvtColor(right, right, cv::COLOR_BGR2GRAY);
+        }
+        if (euroc) {
+          // EuRoC's cameras are grey too; file names are the nanosecond stamps.
+          const std::string name = euroc_stamp(scene.timestamp(i)) + ".png";
+          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+          write_png(dir / "mav0/cam0/data" / name, gray);
+          write_png(dir / "mav0/cam1/data" / name, right);
+        } else if (kitti) {
+          // KITTI's odometry pair is grey: the left is the colour image's grey conversion, which
+          // is what the TUM-layout run extracts from, so both layouts track the same pixels.
+          char name[32];
+          std::snprintf(name, sizeof(name), "%06zu.png", i);
+          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+          write_png(dir / "image_0" / name, gray);
+          write_png(dir / "image_1" / name, right);
+        } else {
+          const std::string name = format_timestamp(frame.timestamp) + ".png";
+          write_png(dir / "rgb" / name, frame.bgr);
+          frame.depth_sensor.convertTo(depth_u16, CV_16U, 5000.0);
+          write_png(dir / "depth" / name, depth_u16);
+          write_png(dir / "mask" / name, frame.labels);
+          if (stereo) write_png(dir / "right" / name, right);
+        }
       } catch (...) {
         std::lock_guard lock(mutex);
         if (!first_error) first_error = std::current_exception();
@@ -248,12 +379,28 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   for (std::thread& thread : pool) thread.join();
   if (first_error) std::rethrow_exception(first_error);
 
+  write_ground_truth(dir, scene);
+  if (euroc) {
+    write_euroc_files(dir, scene);
+    write_info(dir, scene);
+    return;
+  }
+  if (kitti) {
+    // The camera comes from calib.txt; config.yaml would not be read in this layout.
+    write_kitti_files(dir, scene);
+    write_info(dir, scene);
+    return;
+  }
   write_frame_list(dir, "rgb.txt", "rgb", "color images", scene);
   write_frame_list(dir, "depth.txt", "depth",
                    "depth maps (16-bit PNG, 5000 per metre, 0 = no reading)", scene);
   write_frame_list(dir, "mask.txt", "mask",
                    "ground-truth labels (0 static, 15 person, 100 carried object)", scene);
-  write_ground_truth(dir, scene);
+  if (stereo) {
+    write_frame_list(dir, "right.txt", "right",
+                     "rectified right images (8-bit grey) of the stereo pair", scene);
+    save_config(dir / "config_rgbd.yaml", scene.rgbd_system_config());
+  }
   save_config(dir / "config.yaml", scene.system_config());
   if (scene.options().sensor == SynthSensor::kKinect) write_body_to_camera(dir, scene);
   write_info(dir, scene);

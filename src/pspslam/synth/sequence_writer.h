@@ -18,6 +18,10 @@ using SynthProgress = std::function<void(size_t frames_done)>;
 //   (8-bit kSynthLabel* values), rgb.txt, depth.txt, mask.txt, groundtruth.txt (camera-to-world),
 //   config.yaml (save_config of synthetic_system_config()), info.yaml (generator parameters),
 //   README.txt (what the files are).
+// With a stereo baseline also right/<ts>.png (8-bit grey, rectified right camera), right.txt,
+// config.yaml for the stereo camera and config_rgbd.yaml for the RGB-D one. With the KITTI
+// layout instead: image_0/, image_1/ (grey, %06d.png), times.txt, calib.txt, poses.txt,
+// groundtruth.txt (TUM, the same poses) and info.yaml.
 // Frames are rendered and encoded in parallel (options().threads workers); the output bytes do
 // not depend on the thread count. Throws pspslam::Error naming the path that cannot be written.
 void write_sequence(const SyntheticScene& scene, const std::filesystem::path& dir,

@@ -75,6 +75,7 @@
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/place/place_recognition.h"
+#include "pspslam/system/frame_builder.h"
 #include "pspslam/tracking/keyframe_sink.h"
 
 namespace pspslam {
@@ -172,6 +173,8 @@ System::System(const SystemConfig& config, SystemOptions options)
     : camera_(std::make_shared<const RgbdCamera>(
           RgbdCamera::from_config(config.camera, options.virtual_baseline))),
       pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
+      frame_builder_(
+          make_frame_builder(config, camera_, pyramid_, options.dynamic.mode != DynamicMode::off)),
       extractor_(std::make_unique<OrbExtractor>(config.orb)),
       map_(std::make_shared<Map>()) {
   if (options.localization_only) {
@@ -246,30 +249,32 @@ System::System(const SystemConfig& config, SystemOptions options)
 System::~System() { shutdown(); }
 
 FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
-  if (!frame.gray.empty()) return track(frame.timestamp, frame.gray, frame.depth, dynamic_mask);
-  cv::Mat gray;
-  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-  return track(frame.timestamp, gray, frame.depth, dynamic_mask);
-}
-
-FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
-                          const cv::Mat& dynamic_mask) {
   FrameReport report;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_ms();
+  cv::Mat gray = frame.gray;
+  if (gray.empty()) cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
   OrbFeatures features;
-  extractor_->extract(gray, dynamic_mask, features);
-  Frame frame(next_frame_id_++, timestamp, std::move(features.keypoints),
-              std::move(features.descriptors), depth_metres, camera_, pyramid_);
+  frame_builder_->extract(frame, gray, dynamic_mask, features);
+  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), {});
   report.extraction_ms = milliseconds_since(start);
   const double cpu_tracking_start = thread_cpu_ms();
   report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
   wait_for_local_mapping_if_synchronous();
   const auto tracking_start = std::chrono::steady_clock::now();
-  report.tracking = tracker_->track(std::move(frame));
+  report.tracking = tracker_->track(std::move(tracked_frame));
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
   return report;
+}
+
+FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
+                          const cv::Mat& dynamic_mask) {
+  RgbdFrame frame;
+  frame.timestamp = timestamp;
+  frame.gray = gray;
+  frame.depth = depth_metres;
+  return track(frame, dynamic_mask);
 }
 
 void System::announce(const RgbdFrame& frame) {
@@ -290,7 +295,8 @@ FrameReport System::process(const RgbdFrame& frame) {
 
   const auto extraction_start = std::chrono::steady_clock::now();
   OrbFeatures features;
-  extractor_->extract(gray, semantic_mask, features);
+  frame_builder_->extract(frame, gray, semantic_mask, features);
+  const cv::Mat depth = frame_builder_->depth_image(frame);
   report.extraction_ms = milliseconds_since(extraction_start);
   {
     // A loop correction or global BA moved the map since the last frame: the geometry prior
@@ -303,10 +309,9 @@ FrameReport System::process(const RgbdFrame& frame) {
   }
   std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
   if (fates) record_fates_before_removal(gray, semantic_mask, *fates);
-  dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic, fates);
+  dynamic_->remove_dynamic(depth, semantic_mask, features, report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
-  Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),
-                      std::move(features.descriptors), frame.depth, camera_, pyramid_);
+  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), depth);
   report.extraction_ms += milliseconds_since(frame_start);
   report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
 
@@ -320,7 +325,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   // local mapping refines: a deterministic run lets it finish this frame's keyframe first, or the
   // result would depend on thread timing (bonn `exhaustive` varied 0.0183-0.0199 m run to run).
   wait_for_local_mapping_if_synchronous();
-  dynamic_->end_frame(report.tracking, frame.depth, semantic_mask, report.dynamic);
+  dynamic_->end_frame(report.tracking, depth, semantic_mask, report.dynamic);
   if (fates) record_fates_of_tracked_frame(*fates);
   return report;
 }

@@ -16,6 +16,7 @@
 namespace pspslam {
 
 class DynamicPipeline;
+class FrameBuilder;
 class LocalMapping;
 class LoopClosing;
 class Map;
@@ -114,6 +115,7 @@ class System {
   // Tracks one frame. `dynamic_mask` (CV_8UC1, non-zero = do not extract features there) may
   // be empty. Uses frame.gray when present, else converts frame.bgr.
   FrameReport track(const RgbdFrame& frame, const cv::Mat& dynamic_mask = {});
+  // RGB-D only (tests): the frame from its parts.
   FrameReport track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
                     const cv::Mat& dynamic_mask = {});
 
@@ -162,7 +164,9 @@ class System {
 
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
-  std::unique_ptr<OrbExtractor> extractor_;
+  // Per-sensor: extraction, depth and the Frame (system/frame_builder.h).
+  std::unique_ptr<FrameBuilder> frame_builder_;
+  std::unique_ptr<OrbExtractor> extractor_;  // record_keypoint_fates' unmasked extraction only
   // Shared with the local mapping thread, which needs the map for as long as it runs.
   std::shared_ptr<Map> map_;
   // Shared with local mapping (indexes keyframes) and tracking (relocalisation queries).

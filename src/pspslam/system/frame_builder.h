@@ -1,0 +1,48 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+
+#include "pspslam/config/config.h"
+#include "pspslam/feature/orb_extractor.h"
+#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/map/frame.h"
+
+namespace pspslam {
+
+// Everything that differs between sensors from the images to the Frame the tracker sees, in one
+// place (issue #16): past the Frame, tracking, mapping and loop closing treat every keypoint
+// alike, with a depth and a right coordinate u_r = u - bf / z (measured for stereo, derived from
+// the depth image with a virtual baseline for RGB-D), so the same stereo reprojection residual
+// serves both sensors in pose optimisation and bundle adjustment.
+//
+// System drives it per frame: extract -> [dynamic pipeline: depth_image, remove_dynamic] -> build.
+class FrameBuilder {
+ public:
+  virtual ~FrameBuilder() = default;
+
+  // ORB features of the (left) image, none on `mask` (may be empty). `gray` is the frame's
+  // (left) image in grey.
+  virtual void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
+                       OrbFeatures& features) = 0;
+
+  // The frame's depth image (CV_32FC1 metres, 0 = none) for the dynamic pipeline: the geometry
+  // stage compares it with its reference views around projected pixels and the culler reads it
+  // at map points, so it must be dense. RGB-D: the sensor's image; stereo: computed here.
+  virtual cv::Mat depth_image(const RgbdFrame& frame) = 0;
+
+  // The tracked frame from the features left after dynamic removal. `depth` is what
+  // depth_image() returned, or empty when no dynamic pipeline runs.
+  virtual Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
+                      const cv::Mat& depth) = 0;
+};
+
+// The builder of `config.camera.type`. `dense_depth`: depth_image() will be called every frame
+// (a dynamic pipeline runs), so a stereo builder computes it beside the extraction.
+std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
+                                                 std::shared_ptr<const RgbdCamera> camera,
+                                                 std::shared_ptr<const ScalePyramid> pyramid,
+                                                 bool dense_depth);
+
+}  // namespace pspslam

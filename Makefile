@@ -20,7 +20,7 @@ build: configure
 demo: build
 	$(PSPSLAM) synth --out $(DEMO)/sequence --frames 300 --bodies 3 --seed 1
 	$(PSPSLAM) run --sequence $(DEMO)/sequence --out $(DEMO)/run
-	$(PSPSLAM) eval --gt $(DEMO)/sequence/groundtruth.txt --est $(DEMO)/run/trajectory_refined.txt --plot $(DEMO)/run/plots
+	$(PSPSLAM) eval --gt $(DEMO)/sequence/groundtruth.txt --est $(DEMO)/run/trajectory.txt --plot $(DEMO)/run/plots
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)

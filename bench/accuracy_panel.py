@@ -6,6 +6,7 @@ usage: bench/accuracy_panel.py [--variant-flags "..."] [--variant-sed EXPR] [--v
                                [--base-flags "..."] [--base-sed EXPR] [--base-build DIR]
                                [--mode full] [--cells dev,synth] [--jobs 2] [--work DIR]
                                [--no-spread] [--title TEXT] [--synth-sensor ideal|kinect]
+                               [--base-only | --reuse-base WORK]
 
 A variant is extra `pspslam run` flags, a sed expression applied to every cell's camera config,
 another build folder (a branch built elsewhere), or any mix; so is the baseline (default: this
@@ -32,7 +33,12 @@ Per cell and file (trajectory.txt = online, trajectory_refined.txt = final) the 
 `pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
 to the ground truth than the online poses of the same frames. Writes WORK/panel.md and
 WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes (delete WORK, or
-give another, after a rebuild). Needs only the Python standard library.
+give another, after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no
+table); --reuse-base WORK links those runs of another WORK (same baseline build, flags and cells)
+into this one instead of running them again, so a variant costs a third of the runs. Runs are
+deterministic (a variant identical to the baseline gives byte-identical trajectories where no loop
+closes), so a linked baseline is the baseline this invocation would have run. Needs only the Python
+standard library.
 """
 import argparse
 import concurrent.futures
@@ -365,6 +371,10 @@ def main():
     parser.add_argument("--no-spread", action="store_true",
                         help="skip the baseline's spread runs (no 'loss > spread' verdicts)")
     parser.add_argument("--title", default="")
+    parser.add_argument("--base-only", action="store_true",
+                        help="run only the baseline and its spread runs (for --reuse-base)")
+    parser.add_argument("--reuse-base", default=None,
+                        help="link the baseline and spread runs of this earlier --work folder")
     parser.add_argument("--synth-sensor", default="ideal", choices=["ideal", "kinect"],
                         help="`pspslam synth --sensor` of the synth cells")
     args = parser.parse_args()
@@ -381,16 +391,28 @@ def main():
         clis[label] = cli
     cells = prepare_cells(args, work, clis["base"])
 
+    linked = 0
+    if args.reuse_base:
+        for cell in cells:
+            for label in ("base", "spread"):
+                source = Path(args.reuse_base).resolve() / "runs" / cell.name / label
+                target = work / "runs" / cell.name / label
+                if (source / "stats.json").exists() and not target.exists():
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    target.symlink_to(source, target_is_directory=True)
+                if target.is_symlink():
+                    linked += 1
     jobs, keys = [], []
     for cell in cells:
         base_config = apply_sed(cell.config_text, args.base_sed)
         jobs.append((clis["base"], cell, base_config, shlex.split(args.base_flags),
                      work / "runs" / cell.name / "base", args.mode))
         keys.append(("base", cell))
-        jobs.append((clis["variant"], cell, apply_sed(cell.config_text, args.variant_sed),
-                     shlex.split(args.variant_flags), work / "runs" / cell.name / "variant",
-                     args.mode))
-        keys.append(("variant", cell))
+        if not args.base_only:
+            jobs.append((clis["variant"], cell, apply_sed(cell.config_text, args.variant_sed),
+                         shlex.split(args.variant_flags), work / "runs" / cell.name / "variant",
+                         args.mode))
+            keys.append(("variant", cell))
         if not args.no_spread:
             jittered = set_depth_factor(base_config, int(depth_factor(base_config) + 1))
             jobs.append((clis["base"], cell, jittered, shlex.split(args.base_flags),
@@ -402,11 +424,15 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for (label, _), measured in zip(keys, pool.map(run_one, jobs)):
             results[label].update(measured)
+    if args.base_only:
+        log(f"baseline and spread runs done in {work}")
+        return
     markdown, summary = summarise(cells, results["base"], results["variant"], results["spread"],
                                   args)
     load = os.getloadavg()
-    markdown += (f"\n_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {len(jobs)} runs in "
-                 f"{(time.time() - started) / 60:.1f} min, {args.jobs} at a time, load "
+    reused = f" ({linked} linked from {args.reuse_base})" if linked else ""
+    markdown += (f"\n_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {len(jobs)} runs"
+                 f"{reused} in {(time.time() - started) / 60:.1f} min, {args.jobs} at a time, load "
                  f"{load[0]:.1f}; command: `{' '.join(map(shlex.quote, sys.argv))}`_\n")
     (work / "panel.md").write_text(markdown)
     (work / "panel.json").write_text(json.dumps(summary, indent=1))

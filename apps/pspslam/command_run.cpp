@@ -19,10 +19,12 @@
 
 #include <iostream>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "commands.h"
 #include "flag_checks.h"
@@ -114,7 +116,8 @@ struct RunFlags {
   bool realtime = false;
   int mask_margin = 5;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
-  std::string vocabulary;  // empty: the shipped vocabulary
+  std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
+  std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
   std::string loop_closing = "auto";
   std::string save_map;
@@ -160,6 +163,10 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   system.local_mapping = !flags.no_local_mapping;
   system.synchronous_local_mapping = !flags.realtime;
   system.tracker.keyframes.tracked_ratio_to_reference = flags.keyframe_ratio;
+  if (flags.motion_prior.size() == 2) {
+    system.tracker.motion_prior_sigma_translation = flags.motion_prior[0] * 1e-3;
+    system.tracker.motion_prior_sigma_rotation = flags.motion_prior[1] * std::numbers::pi / 180.0;
+  }
   dynamic.realtime = flags.realtime;
   dynamic.semantic.mask_dilation_px = flags.mask_margin;
   dynamic.culling.min_dynamic_hits = flags.cull_hits;
@@ -255,6 +262,13 @@ Command add_run_command(CLI::App& root) {
                   "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)")
       ->check(in_range(0.01, 1.0))
       ->capture_default_str();
+  app->add_option("--motion-prior", flags->motion_prior,
+                  "MM DEG: optimise each frame tracked with the motion model with its "
+                  "constant-velocity prediction as a prior of these σs (translation mm, rotation "
+                  "degrees; default: no prior; an experiment: less jitter, not a lower ATE, "
+                  "docs/benchmarks.md)")
+      ->expected(2)
+      ->check(in_range(1e-3, 1e3));
   app->add_option("--vocabulary", flags->vocabulary,
                   "ORB bag-of-words vocabulary for relocalisation and loop closing (default: the "
                   "shipped models/vocabulary/orb_k10_l5.pspvoc)");

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -369,6 +370,39 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
                              bad + "'"))
         << r.output;
   }
+}
+
+// --motion-prior reaches the pose-only optimisation: a prior of 1 mm / 0.05° makes the online
+// positions follow the constant-velocity prediction, so their second differences (frame-to-frame
+// changes of the velocity) shrink; σ ≤ 0 is an error.
+TEST(CliRun, MotionPriorSmoothsTheOnlineTrajectory) {
+  const auto dir = testing::make_temp_dir("cli_motion_prior");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 0 --seed 3");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const auto roughness = [&](const std::string& name, const std::string& flags) {
+    const auto out = dir / name;
+    const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " + out.string() +
+                             " --dynamic off --loop-closing off" + flags);
+    EXPECT_EQ(r.status, 0) << r.output;
+    const Trajectory online = read_tum_trajectory(out / "trajectory.txt");
+    EXPECT_EQ(online.size(), 40u);
+    double sum = 0.0;
+    for (size_t i = 2; i < online.size(); ++i)
+      sum += (online[i].T_world_camera.translation() -
+              2.0 * online[i - 1].T_world_camera.translation() +
+              online[i - 2].T_world_camera.translation())
+                 .squaredNorm();
+    return std::sqrt(sum / static_cast<double>(online.size() - 2));
+  };
+  const double free = roughness("free", "");
+  const double smooth = roughness("prior", " --motion-prior 1 0.05");
+  EXPECT_LT(smooth, 0.5 * free) << "second differences " << smooth << " vs " << free << " m";
+  const Result bad = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                             (dir / "bad").string() + " --motion-prior 0 1");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.output, "error: pspslam run: --motion-prior: must be a number in"))
+      << bad.output;
 }
 
 // A sequence whose depth images are all empty never starts a map: `run` says why after a second

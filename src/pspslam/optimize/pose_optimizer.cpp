@@ -1,7 +1,10 @@
 #include "pspslam/optimize/pose_optimizer.h"
 
 #include <ceres/problem.h>
+#include <ceres/sized_cost_function.h>
 #include <ceres/solver.h>
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
@@ -146,6 +149,37 @@ class FrameReprojectionCost final : public ceres::CostFunction {
   double huber_delta_stereo_;
 };
 
+// The prior's residual r = S (δ − δ_prior), where δ_prior = (Log R_d, t_d) with
+// (R_d, t_d) = T_prior · T_base⁻¹ is the update that reaches the prior pose exactly and
+// S = diag(1/σ_r, 1/σ_r, 1/σ_r, 1/σ_t, 1/σ_t, 1/σ_t). Linear in δ, so ∂r/∂δ = S.
+class PosePriorCost final : public ceres::SizedCostFunction<6, 6> {
+ public:
+  PosePriorCost(const PosePrior& prior, const Pose& base) {
+    const Pose difference = prior.T_camera_world * base.inverse();
+    const Eigen::AngleAxisd angle_axis(difference.rotation());
+    target_.head<3>() = angle_axis.angle() * angle_axis.axis();
+    target_.tail<3>() = difference.translation();
+    scale_.head<3>().setConstant(1.0 / prior.sigma_rotation);
+    scale_.tail<3>().setConstant(1.0 / prior.sigma_translation);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Map<const Eigen::Matrix<double, 6, 1>> delta(parameters[0]);
+    Eigen::Map<Eigen::Matrix<double, 6, 1>> residual(residuals);
+    residual = scale_.cwiseProduct(delta - target_);
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> jacobian(jacobians[0]);
+      jacobian = scale_.asDiagonal();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Matrix<double, 6, 1> target_;
+  Eigen::Matrix<double, 6, 1> scale_;
+};
+
 std::vector<PreparedObservation> prepare(const std::vector<PoseObservation>& observations,
                                          const std::vector<uint8_t>& selected, const Pose& base) {
   std::vector<PreparedObservation> prepared;
@@ -180,7 +214,7 @@ ceres::Solver::Options round_solver_options(const PoseOptimizerOptions& options)
 PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
                                      const Pose& initial_T_camera_world,
                                      const std::vector<PoseObservation>& observations,
-                                     const PoseOptimizerOptions& options) {
+                                     const PoseOptimizerOptions& options, const PosePrior* prior) {
   PoseOptimizationResult result;
   result.T_camera_world = initial_T_camera_world;
   result.inlier.assign(observations.size(), 0);
@@ -204,6 +238,9 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
     auto cost = std::make_unique<FrameReprojectionCost>(model, prepare(observations, inlier, pose),
                                                         robust, options);
     problem.AddResidualBlock(cost.release(), nullptr, delta.data());
+    if (prior != nullptr) {
+      problem.AddResidualBlock(new PosePriorCost(*prior, pose), nullptr, delta.data());
+    }
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     pose = apply_update(delta, pose);

@@ -32,6 +32,17 @@ struct PoseObservation {
   double information = 1.0;  // 1 / σ² of the keypoint's pyramid level (σ² = scale²)
 };
 
+// A Gaussian prior on the pose: the constant-velocity prediction of tracking, say. Its residual is
+// the whitened difference between the optimised pose and `T_camera_world` in the optimiser's own
+// left update δ = [ω; v] (T = (Exp(ω), v) · T_prior ⇔ δ = 0): ω is a rotation about the camera
+// centre in the camera frame, v to first order minus the camera-centre displacement in the
+// camera frame, so isotropic σs mean what they say.
+struct PosePrior {
+  Pose T_camera_world = Pose::Identity();
+  double sigma_rotation = 0.0;     // rad; > 0
+  double sigma_translation = 0.0;  // m; > 0
+};
+
 struct PoseOptimizationResult {
   Pose T_camera_world = Pose::Identity();
   std::vector<uint8_t> inlier;  // per observation: 1 = χ² below threshold in the final round
@@ -61,10 +72,13 @@ struct PoseOptimizerOptions {
 
 // Refines initial_T_camera_world. Observations with depth (right_u not NaN) constrain (u, v, u_r)
 // with the virtual stereo baseline bf = fx · b; the others (u, v). Never throws on degenerate
-// input: with no observations it returns the initial pose and num_inliers = 0.
+// input: with no observations it returns the initial pose and num_inliers = 0. With a `prior`,
+// every round also minimises its residual (a 6-dof quadratic term next to the observations';
+// the χ² verdicts on the observations do not include it).
 PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
                                      const Pose& initial_T_camera_world,
                                      const std::vector<PoseObservation>& observations,
-                                     const PoseOptimizerOptions& options = {});
+                                     const PoseOptimizerOptions& options = {},
+                                     const PosePrior* prior = nullptr);
 
 }  // namespace pspslam

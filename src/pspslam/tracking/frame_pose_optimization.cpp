@@ -12,7 +12,7 @@ Pose orthonormalized(const Pose& pose) {
 }
 
 PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
-                                           FramePoseBuffers& buffers) {
+                                           FramePoseBuffers& buffers, const PosePrior* prior) {
   buffers.observations.clear();
   buffers.keypoint_of_observation.clear();
   const ScalePyramid& pyramid = frame.pyramid();
@@ -27,7 +27,7 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
   }
   PoseOptimizationResult optimized =
       optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
-                    buffers.observations, options);
+                    buffers.observations, options, prior);
   frame.set_pose(orthonormalized(optimized.T_camera_world));
   return optimized;
 }

@@ -24,7 +24,9 @@ struct FramePoseBuffers {
 // point, from the frame's pose as the initial guess); sets the optimised, orthonormalised pose
 // on the frame. result.inlier[k] is the verdict on keypoint buffers.keypoint_of_observation[k];
 // what to do with outliers is the caller's choice (tracking flags them, relocalisation drops them).
+// `prior`: see optimize_pose.
 PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
-                                           FramePoseBuffers& buffers);
+                                           FramePoseBuffers& buffers,
+                                           const PosePrior* prior = nullptr);
 
 }  // namespace pspslam

@@ -69,10 +69,12 @@ TrackResult Tracker::track(Frame frame) {
     }
   } else {
     if (last_frame_) replace_replaced_points(*last_frame_);
+    motion_prior_.reset();
     bool ok = false;
     if (state_ == TrackingState::kOk && velocity_ && last_frame_ && last_frame_->has_pose()) {
       ok = track_with_motion_model(frame);
       if (ok) result.method = TrackingMethod::kMotionModel;
+      if (!ok) motion_prior_.reset();  // the prediction failed to match: do not trust it
     }
     if (!ok && state_ == TrackingState::kLost && relocalizer_) {
       ok = relocalize(frame);
@@ -197,8 +199,8 @@ int Tracker::discard_outliers(Frame& frame) {
 }
 
 int Tracker::optimize_frame_pose(Frame& frame) {
-  const PoseOptimizationResult optimized =
-      pspslam::optimize_frame_pose(frame, options_.pose_optimizer, pose_buffers_);
+  const PoseOptimizationResult optimized = pspslam::optimize_frame_pose(
+      frame, options_.pose_optimizer, pose_buffers_, motion_prior_ ? &*motion_prior_ : nullptr);
   for (size_t k = 0; k < pose_buffers_.keypoint_of_observation.size(); ++k) {
     frame.outlier[pose_buffers_.keypoint_of_observation[k]] = optimized.inlier[k] ? 0 : 1;
   }
@@ -207,6 +209,9 @@ int Tracker::optimize_frame_pose(Frame& frame) {
 
 bool Tracker::track_with_motion_model(Frame& frame) {
   frame.set_pose(orthonormalized(*velocity_ * last_frame_->T_camera_world()));
+  if (options_.motion_prior_sigma_rotation > 0.0 && options_.motion_prior_sigma_translation > 0.0)
+    motion_prior_ = PosePrior{frame.T_camera_world(), options_.motion_prior_sigma_rotation,
+                              options_.motion_prior_sigma_translation};
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   int matches =
       search_previous_frame(frame, *last_frame_, options_.motion_search_radius, options_.matcher);

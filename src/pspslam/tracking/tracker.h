@@ -37,6 +37,13 @@ struct TrackerOptions {
   bool localization_only = false;
   MatcherOptions matcher;
   PoseOptimizerOptions pose_optimizer;
+  // A frame tracked with the motion model is optimised with the constant-velocity prediction as a
+  // Gaussian prior of these σs (rad, m; 0 = no prior; `pspslam run --motion-prior MM DEG`). Off:
+  // on the accuracy panel (docs/benchmarks.md, #15 item 4) 3 mm / 0.15° lowered the online
+  // trajectory's frame-to-frame jitter in 13 of 13 cells (median −0.8 mm) but not its ATE (7 wins,
+  // 8 losses), and 1 mm / 0.05° raised the ATE by 2–4 mm: the prior trades jitter for wander.
+  double motion_prior_sigma_rotation = 0.0;
+  double motion_prior_sigma_translation = 0.0;
   RelocalizerOptions relocalizer;
 };
 
@@ -136,8 +143,11 @@ class Tracker {
   TrackerOptions options_;
   TrackingState state_ = TrackingState::kNotInitialized;
 
-  std::optional<Frame> last_frame_;        // the previous frame (tracked or not)
-  std::optional<Pose> velocity_;           // T_current_last of the last two tracked frames
+  std::optional<Frame> last_frame_;  // the previous frame (tracked or not)
+  std::optional<Pose> velocity_;     // T_current_last of the last two tracked frames
+  // The constant-velocity prediction of the frame being tracked, as a prior for its pose-only
+  // optimisations (set only when it was tracked with the motion model and a prior is configured).
+  std::optional<PosePrior> motion_prior_;
   std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
   std::shared_ptr<KeyFrame> reference_keyframe_;
   std::uint64_t last_keyframe_frame_id_ = 0;

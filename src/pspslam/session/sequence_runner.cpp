@@ -147,6 +147,8 @@ RunOutcome SequenceRunner::run() {
     }
     const size_t i = frame.index;
     check_frame_size(frame);
+    if (observer_)
+      system_->set_record_keypoint_fates(images_.writes_overlays() || observer_->wants_detail());
     const FrameReport report = system_->process(frame);
     const TrackResult& result = report.tracking;
     spdlog::debug(
@@ -168,7 +170,10 @@ RunOutcome SequenceRunner::run() {
     statistics_.add_frame(i, report, mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
     ba_ms_before = mapping.local_ba_ms_total;
     progress.update(statistics_.processed(), statistics_.realtime_dropped());
+    if (observer_)
+      observer_->frame_done({frame, report, *system_, statistics_, mapping, estimate_, frames_});
   }
+  if (observer_) observer_->run_ended();
   progress.finish();
   system_->shutdown();
   if (!options_.outputs.save_map.empty()) {

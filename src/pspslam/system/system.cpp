@@ -358,6 +358,10 @@ void System::wait_for_local_mapping_if_synchronous() {
 
 cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }
 
+const GeometryPicture* System::last_geometry_picture() const {
+  return dynamic_ ? &dynamic_->geometry_picture() : nullptr;
+}
+
 cv::Mat System::last_semantic_labels() const {
   return dynamic_ ? dynamic_->semantic_labels() : cv::Mat();
 }

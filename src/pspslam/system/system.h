@@ -138,6 +138,14 @@ class System {
   // without semantics or a mask. Shared, not copied.
   cv::Mat last_semantic_labels() const;
 
+  // The geometry stage's picture of the frame process() handled last (tested points, path,
+  // grown regions); empty unless keypoint fates were recorded for that frame; null with
+  // DynamicMode::off.
+  const GeometryPicture* last_geometry_picture() const;
+  // Turns SystemOptions::record_keypoint_fates on or off from the next frame on: the live viewer
+  // pays the second extraction only for the frames it shows.
+  void set_record_keypoint_fates(bool record) { record_keypoint_fates_ = record; }
+
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
   // Returns the number of keyframes and map points written.
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);

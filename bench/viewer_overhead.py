@@ -1,0 +1,90 @@
+#!/usr/bin/python3
+"""Overhead of the live viewer (issue #17 item 4): `pspslam run --realtime` on bonn_crowd_dev with
+and without `--viewer` + a headless chromium showing the page, in interleaved pairs (the order
+inside a pair alternates), fps and frames processed from stats.json; prints each run and the
+medians. Usage: bench/viewer_overhead.py [BUILD_DIR] [--pairs N] [--dynamic MODE]
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+root = Path(__file__).resolve().parent.parent
+shared = Path(os.environ.get("PSPSLAM_SHARED", root.parent / "shared"))
+
+
+def run_once(cli, sequence, mode, out, viewer):
+    command = [str(cli), "run", "--sequence", str(sequence), "--config", str(root / "config/bonn.yaml"),
+               "--dynamic", mode, "--realtime", "--quiet", "--out", str(out)]
+    if viewer:
+        command += ["--viewer", "127.0.0.1:0"]
+    browser = None
+    log = open(out.parent / (out.name + ".log"), "w+")
+    process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        if viewer:
+            # The page opens as soon as the address is printed, before the first frame.
+            url = None
+            while url is None and process.poll() is None:
+                log.seek(0)
+                match = re.search(r"http://127\.0\.0\.1:\d+/", log.read())
+                url = match.group(0) if match else None
+                time.sleep(0.02)
+            profile = tempfile.mkdtemp(prefix="viewer_overhead_chromium_")
+            browser = subprocess.Popen(
+                ["chromium", "--headless", "--no-sandbox", "--no-proxy-server",
+                 "--enable-unsafe-swiftshader", "--remote-debugging-port=0",
+                 "--window-size=1400,900", f"--user-data-dir={profile}", url],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        process.wait(timeout=600)
+    finally:
+        if browser:
+            browser.terminate()
+            browser.wait()
+            shutil.rmtree(profile, ignore_errors=True)
+    if process.returncode != 0:
+        log.seek(0)
+        raise SystemExit(f"run failed ({process.returncode}):\n{log.read()}")
+    stats = json.loads((out / "stats.json").read_text())
+    return stats["fps"], stats["frames"], stats.get("dropped_frames", 0)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("build", nargs="?", default=str(root / "build"))
+    parser.add_argument("--pairs", type=int, default=3)
+    parser.add_argument("--dynamic", default="full")
+    args = parser.parse_args()
+    cli = Path(args.build) / "apps/pspslam"
+    sequence = shared / "data/bonn_crowd_dev"
+    work = Path(tempfile.mkdtemp(prefix="viewer_overhead_"))
+    print(f"# {time.strftime('%Y-%m-%d %H:%M:%S', time.gmtime())} UTC, load {os.getloadavg()}")
+    results = {False: [], True: []}
+    for pair in range(args.pairs):
+        order = [False, True] if pair % 2 == 0 else [True, False]
+        for viewer in order:
+            out = work / f"pair{pair}_{'viewer' if viewer else 'plain'}"
+            fps, frames, dropped = run_once(cli, sequence, args.dynamic, out, viewer)
+            results[viewer].append((fps, frames))
+            print(f"pair {pair} {'viewer+chromium' if viewer else 'plain          '}: "
+                  f"{fps:.2f} fps, {frames} frames processed, {dropped} dropped by the feed, "
+                  f"load {os.getloadavg()[0]:.2f}", flush=True)
+    plain = statistics.median(f for f, _ in results[False])
+    viewed = statistics.median(f for f, _ in results[True])
+    plain_frames = statistics.median(n for _, n in results[False])
+    viewed_frames = statistics.median(n for _, n in results[True])
+    print(f"median fps: plain {plain:.2f}, viewer {viewed:.2f} ({100 * (viewed / plain - 1):+.1f} %)")
+    print(f"median frames processed: plain {plain_frames}, viewer {viewed_frames} "
+          f"({100 * (viewed_frames / plain_frames - 1):+.1f} %)")
+    print(f"# end {time.strftime('%Y-%m-%d %H:%M:%S', time.gmtime())} UTC, load {os.getloadavg()}")
+    shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

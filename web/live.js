@@ -82,7 +82,7 @@ function drawMarks(frame) {
 const COUNTERS = [
   ['processed', 'frames processed'], ['lost', 'lost frames'], ['relocalisations', 'relocalisations'],
   ['dropped_by_feed', 'dropped by the feed'], ['keyframes', 'keyframes'], ['map_points', 'map points'],
-  ['masked_keypoints', 'keypoints dropped'], ['tested_points', 'points tested'],
+  ['masked_keypoints', 'keypoints removed'], ['tested_points', 'points tested'],
   ['dynamic_points', 'geometry dynamic'], ['culled_map_points', 'map points culled'],
   ['frames_without_mask', 'frames without mask'], ['loops_closed', 'loops closed']];
 
@@ -169,7 +169,7 @@ function showMap(map) {
   layers.points.geometry.setAttribute('position',
                                       new THREE.Float32BufferAttribute(map.positions, 3));
   layers.points.geometry.computeBoundingSphere();
-  layers.keyframes.geometry.setFromPoints(frustumPoints(map.keyframes, 0.05));
+  layers.keyframes.geometry.setFromPoints(frustumPoints(map.keyframes, 0.08));
   const centres = map.keyframes.map((pose) => new THREE.Vector3(...pose.p));
   layers.covisibility.geometry.setFromPoints(map.edges.flatMap(([a, b]) => [centres[a], centres[b]]));
   const path = map.trajectory.map((p) => new THREE.Vector3(...p));
@@ -180,13 +180,19 @@ function showMap(map) {
   $('map-keyframes').textContent = map.keyframes.length;
   body.dataset.mapPoints = map.positions.length / 3;
   body.dataset.keyframes = map.keyframes.length;
-  if (!framed && centres.length >= 2) {
+  if (!framed && centres.length >= 2 && map.positions.length) {
+    // Look at the map's median point from above and behind the first keyframe (SLAM's z
+    // forward is -z here): the median ignores the few far points a bounding box would chase.
     framed = true;
-    const box = new THREE.Box3().setFromPoints(centres);
-    box.applyMatrix4(view.world.matrixWorld);
-    const centre = box.getCenter(new THREE.Vector3());
-    view.camera.position.copy(centre).add(new THREE.Vector3(0.8, 1.2, 1.6));
-    view.controls.target.copy(centre);
+    const median = [0, 1, 2].map((axis) => {
+      const values = map.positions.filter((_, i) => i % 3 === axis).sort((a, b) => a - b);
+      return values[values.length >> 1];
+    });
+    const target = new THREE.Vector3(...median).applyMatrix4(view.world.matrixWorld);
+    const start = centres[0].clone().applyMatrix4(view.world.matrixWorld);
+    const distance = Math.max(start.distanceTo(target), 0.5);
+    view.camera.position.copy(start).add(new THREE.Vector3(0.15, 0.45, 0.6).multiplyScalar(distance));
+    view.controls.target.copy(target);
     view.controls.update();
   }
   requestRender();

@@ -264,7 +264,10 @@ void LiveViewer::frame_done(const FrameView& view) {
     last_map_keyframes_ = view.mapping.keyframes_in_map;
   }
   work_.notify_one();
-  if (!paused_ || options_.realtime) return;
+  // A pause that came while this frame was processed without its keypoint fates holds after the
+  // next frame, which records them (wants_detail() says so while paused): the held frame is
+  // always shown whole.
+  if (!paused_ || options_.realtime || !detail) return;
   // Held between frames until resume or step; the poll lets Ctrl-C end a paused run.
   waiting_ = true;
   held_frame_ = view.frame.index;

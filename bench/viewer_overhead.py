@@ -52,7 +52,7 @@ def run_once(cli, sequence, mode, out, viewer):
         log.seek(0)
         raise SystemExit(f"run failed ({process.returncode}):\n{log.read()}")
     stats = json.loads((out / "stats.json").read_text())
-    return stats["fps"], stats["frames"], stats.get("dropped_frames", 0)
+    return stats["fps"], stats["frames"], stats.get("realtime_dropped_frames", 0)
 
 
 def main():

@@ -98,6 +98,13 @@ WebServer::WebServer(fs::path web_root, std::string index_file) : impl_(std::mak
   }
   impl_->root = std::move(web_root);
   impl_->index_file = std::move(index_file);
+  // httplib's default also sets SO_REUSEPORT, with which a second run on the same port binds
+  // silently and the two share (and split) the browser's requests. SO_REUSEADDR alone still
+  // lets a port be reused right after a run ended (TIME_WAIT).
+  impl_->server.set_socket_options([](socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
 }
 
 WebServer::~WebServer() { stop(); }

@@ -137,8 +137,15 @@ view.world.add(new THREE.AxesHelper(0.3));
 let framed = false;
 let currentPosition = null;
 
+// three.js (r163+) fills an existing position buffer in place and cannot grow it, and the map
+// grows: each update gets a new geometry.
+function setPoints(layer, points) {
+  layer.geometry.dispose();
+  layer.geometry = new THREE.BufferGeometry().setFromPoints(points);
+}
+
 function setCurrentCamera(pose) {
-  layers.camera.geometry.setFromPoints(frustumPoints([pose], 0.12));
+  setPoints(layers.camera, frustumPoints([pose], 0.12));
   const position = new THREE.Vector3(...pose.p).applyMatrix4(view.world.matrixWorld);
   if ($('follow').checked && currentPosition) {
     // Keep the orbit camera's offset: the view moves with the SLAM camera.
@@ -166,32 +173,33 @@ async function loadMap(version) {
 }
 
 function showMap(map) {
+  layers.points.geometry.dispose();
+  layers.points.geometry = new THREE.BufferGeometry();
   layers.points.geometry.setAttribute('position',
                                       new THREE.Float32BufferAttribute(map.positions, 3));
-  layers.points.geometry.computeBoundingSphere();
-  layers.keyframes.geometry.setFromPoints(frustumPoints(map.keyframes, 0.08));
+  setPoints(layers.keyframes, frustumPoints(map.keyframes, 0.08));
   const centres = map.keyframes.map((pose) => new THREE.Vector3(...pose.p));
-  layers.covisibility.geometry.setFromPoints(map.edges.flatMap(([a, b]) => [centres[a], centres[b]]));
-  const path = map.trajectory.map((p) => new THREE.Vector3(...p));
-  layers.trajectory.geometry.setFromPoints(path);
-  layers.truth.geometry.setFromPoints(map.truth.map((p) => new THREE.Vector3(...p)));
+  setPoints(layers.covisibility, map.edges.flatMap(([a, b]) => [centres[a], centres[b]]));
+  setPoints(layers.trajectory, map.trajectory.map((p) => new THREE.Vector3(...p)));
+  setPoints(layers.truth, map.truth.map((p) => new THREE.Vector3(...p)));
   $('ate').textContent = map.ate_rmse >= 0 ? `ATE ${(map.ate_rmse * 1000).toFixed(1)} mm` : '';
   $('map-points').textContent = map.positions.length / 3;
   $('map-keyframes').textContent = map.keyframes.length;
   body.dataset.mapPoints = map.positions.length / 3;
   body.dataset.keyframes = map.keyframes.length;
   if (!framed && centres.length >= 2 && map.positions.length) {
-    // Look at the map's median point from above and behind the first keyframe (SLAM's z
-    // forward is -z here): the median ignores the few far points a bounding box would chase.
+    // Look from above and behind the first keyframe (SLAM's z forward is -z here) towards the
+    // map's median point: the median ignores the few far points a bounding box would chase.
     framed = true;
     const median = [0, 1, 2].map((axis) => {
       const values = map.positions.filter((_, i) => i % 3 === axis).sort((a, b) => a - b);
       return values[values.length >> 1];
     });
-    const target = new THREE.Vector3(...median).applyMatrix4(view.world.matrixWorld);
+    // Aimed between the first keyframe and the map's median point, so the cameras stay in view.
     const start = centres[0].clone().applyMatrix4(view.world.matrixWorld);
+    const target = new THREE.Vector3(...median).applyMatrix4(view.world.matrixWorld).lerp(start, 0.45);
     const distance = Math.max(start.distanceTo(target), 0.5);
-    view.camera.position.copy(start).add(new THREE.Vector3(0.15, 0.45, 0.6).multiplyScalar(distance));
+    view.camera.position.copy(start).add(new THREE.Vector3(0.22, 0.65, 0.9).multiplyScalar(distance));
     view.controls.target.copy(target);
     view.controls.update();
   }

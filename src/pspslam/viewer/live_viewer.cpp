@@ -103,12 +103,16 @@ cv::Mat label_picture(const cv::Mat& labels, cv::Size size, const OverlayClasses
   return picture;
 }
 
-// Grown dynamic regions: orange, translucent.
+// Grown dynamic regions: a faint orange fill and a solid outline, so they read on top of the
+// person labels they mostly agree with.
 cv::Mat region_picture(const cv::Mat& regions, cv::Size size) {
   cv::Mat small;
   cv::resize(regions, small, size, 0, 0, cv::INTER_NEAREST);
   cv::Mat picture(small.size(), CV_8UC4, cv::Scalar::all(0));
-  picture.setTo(cv::Scalar(0, 140, 255, 110), small);
+  picture.setTo(cv::Scalar(0, 140, 255, 70), small);
+  std::vector<std::vector<cv::Point>> outlines;
+  cv::findContours(small, outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::drawContours(picture, outlines, -1, cv::Scalar(0, 140, 255, 255), 2);
   return picture;
 }
 

@@ -13,18 +13,23 @@ import statistics
 import subprocess
 import tempfile
 import time
+import urllib.request
 from pathlib import Path
+
+# The server is local: no proxy.
+opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
 
 root = Path(__file__).resolve().parent.parent
 shared = Path(os.environ.get("PSPSLAM_SHARED", root.parent / "shared"))
 
 
-def run_once(cli, sequence, mode, out, viewer):
+def run_once(cli, sequence, mode, out, viewer, attach_browser=True):
     command = [str(cli), "run", "--sequence", str(sequence), "--config", str(root / "config/bonn.yaml"),
                "--dynamic", mode, "--realtime", "--quiet", "--out", str(out)]
     if viewer:
         command += ["--viewer", "127.0.0.1:0"]
     browser = None
+    pages = 0
     log = open(out.parent / (out.name + ".log"), "w+")
     process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
     try:
@@ -37,22 +42,34 @@ def run_once(cli, sequence, mode, out, viewer):
                 url = match.group(0) if match else None
                 time.sleep(0.02)
             profile = tempfile.mkdtemp(prefix="viewer_overhead_chromium_")
-            browser = subprocess.Popen(
+            browser = None if not attach_browser else subprocess.Popen(
                 ["chromium", "--headless", "--no-sandbox", "--no-proxy-server",
                  "--enable-unsafe-swiftshader", "--remote-debugging-port=0",
                  "--window-size=1400,900", f"--user-data-dir={profile}", url],
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            # Proof that a page is attached: the server counts its open event streams.
+            pages = 0
+            while process.poll() is None:
+                try:
+                    state = json.loads(opener.open(url + "api/live/state", timeout=5).read())
+                    pages = max(pages, state["state"]["pages"])
+                except (OSError, ValueError):
+                    pass
+                time.sleep(0.5)
+            if pages == 0 and attach_browser:
+                raise SystemExit("no page attached to the viewer during the run")
         process.wait(timeout=600)
     finally:
         if browser:
             browser.terminate()
             browser.wait()
+        if viewer:
             shutil.rmtree(profile, ignore_errors=True)
     if process.returncode != 0:
         log.seek(0)
         raise SystemExit(f"run failed ({process.returncode}):\n{log.read()}")
     stats = json.loads((out / "stats.json").read_text())
-    return stats["fps"], stats["frames"], stats.get("realtime_dropped_frames", 0)
+    return stats["fps"], stats["frames"], stats.get("realtime_dropped_frames", 0), pages if viewer else 0
 
 
 def main():
@@ -60,6 +77,8 @@ def main():
     parser.add_argument("build", nargs="?", default=str(root / "build"))
     parser.add_argument("--pairs", type=int, default=3)
     parser.add_argument("--dynamic", default="full")
+    parser.add_argument("--no-browser", action="store_true",
+                        help="the viewer without a page attached (the server's own cost)")
     args = parser.parse_args()
     cli = Path(args.build) / "apps/pspslam"
     sequence = shared / "data/bonn_crowd_dev"
@@ -70,10 +89,12 @@ def main():
         order = [False, True] if pair % 2 == 0 else [True, False]
         for viewer in order:
             out = work / f"pair{pair}_{'viewer' if viewer else 'plain'}"
-            fps, frames, dropped = run_once(cli, sequence, args.dynamic, out, viewer)
+            fps, frames, dropped, pages = run_once(cli, sequence, args.dynamic, out, viewer,
+                                                   not args.no_browser)
             results[viewer].append((fps, frames))
-            print(f"pair {pair} {'viewer+chromium' if viewer else 'plain          '}: "
+            print(f"pair {pair} {('viewer+chromium' if not args.no_browser else 'viewer only    ') if viewer else 'plain          '}: "
                   f"{fps:.2f} fps, {frames} frames processed, {dropped} dropped by the feed, "
+                  f"{pages} page(s) attached, "
                   f"load {os.getloadavg()[0]:.2f}", flush=True)
     plain = statistics.median(f for f, _ in results[False])
     viewed = statistics.median(f for f, _ in results[True])

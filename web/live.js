@@ -93,6 +93,9 @@ function showFrame(frame, version) {
   $('frame-total').textContent = frame.total ? ` / ${frame.total - 1}` : '';
   body.dataset.frame = frame.index;
   frame.fates.forEach((n, i) => { $(`fate-${i}`).textContent = frame.detail ? n : '–'; });
+  // A real-time run does not pay the second extraction that finds them: the label overlay
+  // shows the mask instead.
+  if (frame.detail && !frame.masked_recorded) $('fate-2').textContent = 'not recorded (--realtime)';
   // Dynamic keypoints of the shown frame: dropped by the semantic mask or by geometry.
   const dynamic = frame.fates[2] + frame.fates[3];
   body.dataset.dynamicKeypoints = dynamic;

@@ -28,9 +28,16 @@ struct FrameView {
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
-  // Asked before each frame: true to get that frame's keypoint fates, tested points and grown
-  // regions (they cost a second ORB extraction, so only for the frames that will be shown).
-  virtual bool wants_detail() = 0;
+  // What the observer wants recorded for the next frame.
+  struct Detail {
+    // Keypoint fates, tested points and grown regions: only for the frames that will be shown.
+    bool fates = false;
+    // With fates, also the keypoints the semantic mask kept from being extracted: they cost a
+    // second, unmasked ORB extraction on the run loop's thread.
+    bool masked_keypoints = false;
+  };
+  // Asked before each frame.
+  virtual Detail wants_detail() = 0;
   // After each frame. May block (a paused viewer) until the loop may go on; it must return
   // once interrupted() is true.
   virtual void frame_done(const FrameView& view) = 0;

@@ -147,8 +147,12 @@ RunOutcome SequenceRunner::run() {
     }
     const size_t i = frame.index;
     check_frame_size(frame);
-    if (observer_)
-      system_->set_record_keypoint_fates(images_.writes_overlays() || observer_->wants_detail());
+    if (observer_) {
+      const RunObserver::Detail detail = observer_->wants_detail();
+      const bool overlays = images_.writes_overlays();
+      system_->set_record_keypoint_fates(overlays || detail.fates,
+                                         overlays || detail.masked_keypoints);
+    }
     const FrameReport report = system_->process(frame);
     const TrackResult& result = report.tracking;
     spdlog::debug(

@@ -302,7 +302,7 @@ FrameReport System::process(const RgbdFrame& frame) {
     }
   }
   std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
-  if (fates) record_fates_before_removal(gray, semantic_mask, *fates);
+  if (fates && record_masked_fates_) record_fates_before_removal(gray, semantic_mask, *fates);
   dynamic_->remove_dynamic(frame.depth, semantic_mask, features, report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame(next_frame_id_++, frame.timestamp, std::move(features.keypoints),

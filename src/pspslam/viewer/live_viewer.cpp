@@ -176,10 +176,10 @@ LiveViewer::~LiveViewer() {
   encoder_.join();
 }
 
-bool LiveViewer::wants_detail() {
+RunObserver::Detail LiveViewer::wants_detail() {
   std::lock_guard lock(mutex_);
   detail_ = paused_ || Clock::now() - last_frame_snapshot_ >= options_.interval;
-  return detail_;
+  return {detail_, detail_ && !options_.realtime};
 }
 
 void LiveViewer::frame_done(const FrameView& view) {
@@ -345,7 +345,8 @@ std::string LiveViewer::state_json() const {
               {"ended", ended_},
               {"realtime", options_.realtime},
               {"frame_version", frame_version_},
-              {"map_version", map_version_}}
+              {"map_version", map_version_},
+              {"pages", server_.open_event_streams()}}
       .dump();
 }
 
@@ -415,6 +416,7 @@ void LiveViewer::publish_frame(const FrameSnapshot& s) {
       {"width", s.bgr.cols},
       {"height", s.bgr.rows},
       {"detail", s.detail},
+      {"masked_recorded", s.detail && !options_.realtime},
       {"state", to_string(s.tracking.state)},
       {"method", to_string(s.tracking.method)},
       {"inliers", s.tracking.num_inliers},

@@ -28,7 +28,9 @@ struct LiveViewerOptions {
   int image_width = 480;  // frames are sent JPEG at this width (never enlarged)
   bool start_paused = false;
   // A real-time feed keeps coming whatever the viewer does: pause is refused (the frames would
-  // be dropped by the source, not held).
+  // be dropped by the source, not held), and the keypoints the semantic mask removed are not
+  // shown (finding them costs a second ORB extraction on the tracking thread; the label overlay
+  // shows the mask instead).
   bool realtime = false;
   std::filesystem::path ground_truth;  // TUM file aligned onto the estimate; empty: none
   OverlayClasses classes;              // the segmentation's classes, for the label colours
@@ -53,7 +55,7 @@ class LiveViewer final : public RunObserver {
 
   const std::string& url() const { return url_; }
 
-  bool wants_detail() override;
+  Detail wants_detail() override;
   void frame_done(const FrameView& view) override;
   void run_ended() override;
 

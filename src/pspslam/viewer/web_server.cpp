@@ -193,6 +193,8 @@ std::string WebServer::listen(const std::string& endpoint_text) {
          "/";
 }
 
+int WebServer::open_event_streams() const { return impl_->event_streams.load(); }
+
 void WebServer::stop() {
   if (!impl_->thread.joinable()) return;
   impl_->server.stop();

@@ -48,6 +48,9 @@ class WebServer {
   // thread of its own and returns the address to open. Warns (spdlog) when the host is not a
   // loopback address. Throws pspslam::Error naming --viewer when it cannot listen.
   std::string listen(const std::string& endpoint);
+  // Event streams open now (pages attached).
+  int open_event_streams() const;
+
   // Stops accepting and waits for the open requests (event streams must end by themselves, see
   // EventWaiter). Idempotent; the destructor calls it.
   void stop();

@@ -151,8 +151,8 @@ LiveViewer::LiveViewer(LiveViewerOptions options)
                                .dump())};
   });
   server_.get("/api/live/state", [this](const WebServer::Query&) {
-    std::uint64_t last = 0;
-    return HttpReply{200, "application/json", share(next_event(last).value_or("{}"))};
+    std::lock_guard lock(mutex_);
+    return HttpReply{200, "application/json", share(event_json())};
   });
   server_.events("/api/live/events", [this](std::uint64_t& last) { return next_event(last); });
   server_.post("/api/pause",
@@ -356,6 +356,10 @@ std::optional<std::string> LiveViewer::next_event(std::uint64_t& last) {
     return std::string();  // keep-alive
   if (closing_) return std::nullopt;
   last = event_;
+  return event_json();
+}
+
+std::string LiveViewer::event_json() const {
   return R"({"event":)" + std::to_string(event_) + R"(,"state":)" + state_json() + R"(,"frame":)" +
          (frame_json_ ? *frame_json_ : std::string("null")) + "}";
 }

@@ -77,6 +77,7 @@ class LiveViewer final : public RunObserver {
   void publish_frame(const FrameSnapshot& snapshot);
   void publish_map(const MapSnapshot& snapshot);
   std::string state_json() const;  // under mutex_
+  std::string event_json() const;  // under mutex_: state + the newest frame's JSON
   std::optional<std::string> next_event(std::uint64_t& last);
   HttpReply control(bool (LiveViewer::*action)());
 

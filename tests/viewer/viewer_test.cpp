@@ -111,6 +111,12 @@ TEST(ViewerServer, RoutesEventsAndStop) {
   EXPECT_EQ(hello->status, 200);
   EXPECT_EQ(hello->body, "{\"name\":\"pspslam\"}");
   EXPECT_EQ(hello->get_header_value("Cache-Control"), "no-store");
+  // Never compressed: httplib's brotli costs far more CPU than the bytes are worth on loopback.
+  client.set_decompress(false);
+  const auto plain = client.Get("/api/hello?name=x", {{"Accept-Encoding", "gzip, deflate, br"}});
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->get_header_value("Content-Encoding"), "");
+  EXPECT_EQ(plain->body, "{\"name\":\"x\"}");
   const auto refused = client.Post("/api/refuse");
   ASSERT_TRUE(refused);
   EXPECT_EQ(refused->status, 409);

@@ -1,7 +1,7 @@
 // The page of `pspslam view`: fills the side panel from /api/stats, then draws the map, the
 // keyframes, the trajectory and the aligned ground truth with three.js.
 import * as THREE from 'three';
-import { OrbitControls } from '/vendor/three/examples/jsm/controls/OrbitControls.js';
+import { frame, frusta, lineThrough, makeView } from '/scene.js';
 
 async function getJson(path) {
   const response = await fetch(path);
@@ -24,35 +24,6 @@ function fillPanel(stats) {
   setText('points', stats.map?.map_points ?? '–');
 }
 
-function lineThrough(positions, color) {
-  const geometry = new THREE.BufferGeometry().setFromPoints(positions);
-  return new THREE.Line(geometry, new THREE.LineBasicMaterial({ color }));
-}
-
-function poseMatrix(pose) {
-  const [x, y, z] = pose.p;
-  const [qx, qy, qz, qw] = pose.q;
-  return new THREE.Matrix4().compose(new THREE.Vector3(x, y, z),
-                                     new THREE.Quaternion(qx, qy, qz, qw),
-                                     new THREE.Vector3(1, 1, 1));
-}
-
-// One small pyramid per keyframe, all in one LineSegments (one draw call): camera centre to the
-// four corners of an image plane at `depth`, in the camera's x-right, y-down, z-forward frame.
-function frusta(keyframes, depth) {
-  const w = depth * 0.6, h = depth * 0.45;
-  const corners = [[-w, -h], [w, -h], [w, h], [-w, h]].map(([x, y]) => new THREE.Vector3(x, y, depth));
-  const points = [];
-  for (const pose of keyframes) {
-    const m = poseMatrix(pose);
-    const centre = new THREE.Vector3().applyMatrix4(m);
-    const world = corners.map((c) => c.clone().applyMatrix4(m));
-    for (let i = 0; i < 4; ++i) points.push(centre, world[i], world[i], world[(i + 1) % 4]);
-  }
-  const geometry = new THREE.BufferGeometry().setFromPoints(points);
-  return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: 0xd0d0d0 }));
-}
-
 function mapPoints(map) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.Float32BufferAttribute(map.positions, 3));
@@ -61,49 +32,20 @@ function mapPoints(map) {
 }
 
 function drawScene(trajectory, map, truth) {
-  const container = document.getElementById('scene');
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(window.devicePixelRatio);
-  renderer.setSize(container.clientWidth, container.clientHeight);
-  renderer.setClearColor(0x1b1d22);
-  container.appendChild(renderer.domElement);
-
-  const scene = new THREE.Scene();
-  // SLAM's world is the first camera's frame (y down, z forward); turn it so y points up.
-  const world = new THREE.Group();
-  world.rotation.x = Math.PI;
-  scene.add(world);
-
+  const view = makeView(document.getElementById('scene'));
   const estimate = trajectory.refined.length ? trajectory.refined : trajectory.online;
   const path = estimate.map((pose) => new THREE.Vector3(...pose.p));
-  if (map.positions.length) world.add(mapPoints(map));
-  if (path.length) world.add(lineThrough(path, 0xe8a33d));
+  if (map.positions.length) view.world.add(mapPoints(map));
+  if (path.length) view.world.add(lineThrough(path, 0xe8a33d));
   if (truth.positions.length)
-    world.add(lineThrough(truth.positions.map((p) => new THREE.Vector3(...p)), 0x3db4e8));
-  world.add(frusta(trajectory.keyframes, 0.05));
-  world.add(new THREE.AxesHelper(0.3));
-
+    view.world.add(lineThrough(truth.positions.map((p) => new THREE.Vector3(...p)), 0x3db4e8));
+  view.world.add(frusta(trajectory.keyframes, 0.05));
+  view.world.add(new THREE.AxesHelper(0.3));
   // Frame the trajectory with room around it: the map's stray far points would shrink the view.
-  const box = new THREE.Box3().setFromPoints(path.length ? path : [new THREE.Vector3()]);
-  world.updateMatrixWorld();
-  box.applyMatrix4(world.matrixWorld);
-  const centre = box.getCenter(new THREE.Vector3());
-  const size = Math.max(box.getSize(new THREE.Vector3()).length(), 1.5);
-  const camera = new THREE.PerspectiveCamera(50, container.clientWidth / container.clientHeight,
-                                             0.01, 1000);
-  camera.position.copy(centre).add(new THREE.Vector3(size * 0.3, size * 0.45, size * 0.6));
-  const controls = new OrbitControls(camera, renderer.domElement);
-  controls.target.copy(centre);
-  controls.update();
-
-  window.addEventListener('resize', () => {
-    camera.aspect = container.clientWidth / container.clientHeight;
-    camera.updateProjectionMatrix();
-    renderer.setSize(container.clientWidth, container.clientHeight);
-  });
-  renderer.setAnimationLoop(() => {
-    controls.update();
-    renderer.render(scene, camera);
+  frame(view, path);
+  view.renderer.setAnimationLoop(() => {
+    view.controls.update();
+    view.renderer.render(view.scene, view.camera);
   });
 }
 

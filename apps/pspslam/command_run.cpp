@@ -17,6 +17,8 @@
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <numbers>
@@ -34,9 +36,11 @@
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/place/place_recognition.h"
+#include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/sequence_runner.h"
+#include "pspslam/viewer/live_viewer.h"
 
 namespace pspslam::cli {
 namespace {
@@ -100,6 +104,16 @@ FrameRange parse_blackout(const std::string& value) {
   }
 }
 
+// The segmentation's classes, for the viewer's label colours; none without semantics.
+OverlayClasses overlay_classes(const DynamicOptions& dynamic) {
+  if (!uses_semantics(dynamic.mode)) return {};
+  const SegmenterMetadata model = load_segmenter_metadata(dynamic.model);
+  const std::vector<std::string>& names = dynamic.semantic.dynamic_classes.empty()
+                                              ? model.dynamic_classes
+                                              : dynamic.semantic.dynamic_classes;
+  return {model.classes, class_ids(model.classes, names, model.file.string())};
+}
+
 }  // namespace
 
 struct RunFlags {
@@ -129,6 +143,9 @@ struct RunFlags {
   std::string export_dense;
   std::string save_masks;
   std::string save_overlays;
+  std::string viewer;  // [HOST:]PORT; empty: no viewer
+  bool viewer_paused = false;
+  int viewer_interval_ms = 250;
 };
 
 // A path the user typed is relative to the current folder; only the built-in defaults are found
@@ -191,8 +208,29 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     if (options.sensor) apply_sensor_override(camera->config, *options.sensor, camera->config_file);
     camera->source = open_camera(spec);
   }
+  // The viewer binds its address before the model and the sequence load, so a port in use is
+  // told at once; it outlives the runner, which only points to it.
+  std::unique_ptr<LiveViewer> viewer;
+  if (!flags.viewer.empty()) {
+    LiveViewerOptions live;
+    live.endpoint = flags.viewer;
+    live.web_root = data_dir() / "web";
+    live.interval = std::chrono::milliseconds(flags.viewer_interval_ms);
+    live.start_paused = flags.viewer_paused;
+    live.realtime = flags.realtime;
+    live.classes = overlay_classes(dynamic);
+    live.title = flags.camera.empty() ? flags.sequence : "camera " + flags.camera;
+    if (!flags.sequence.empty() &&
+        std::filesystem::is_regular_file(std::filesystem::path(flags.sequence) / "groundtruth.txt"))
+      live.ground_truth = std::filesystem::path(flags.sequence) / "groundtruth.txt";
+    viewer = std::make_unique<LiveViewer>(std::move(live));
+    std::cout << "viewer:       " << viewer->url() << "  (live while the run goes"
+              << (flags.viewer_paused ? "; held at the first frame until resume or step" : "")
+              << ")" << std::endl;
+  }
   SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
                                  : SequenceRunner(std::move(options), std::cout);
+  runner.watch(viewer.get());
   switch (runner.run()) {
     case RunOutcome::disconnected:
       return kCameraLostExit;
@@ -320,6 +358,19 @@ Command add_run_command(CLI::App& root) {
                   "every keypoint marked by its fate (tracked / kept unmatched / dropped by the "
                   "semantic mask / dropped by the geometry test) and a legend; costs a second ORB "
                   "extraction per frame");
+  CLI::Option* viewer =
+      app->add_option("--viewer", flags->viewer,
+                      "[HOST:]PORT: show the run live in the browser (frame, keypoint fates, "
+                      "masks, map, timing; host 127.0.0.1 unless given; port 0: any free one)");
+  app->add_flag("--viewer-paused", flags->viewer_paused,
+                "hold the run after its first frame until the page says resume or step "
+                "(deterministic runs)")
+      ->needs(viewer);
+  app->add_option("--viewer-interval", flags->viewer_interval_ms,
+                  "milliseconds between the frames the viewer shows (the run never waits for it)")
+      ->check(in_range(10, 60000))
+      ->needs(viewer)
+      ->capture_default_str();
   return {app, [flags](const GlobalOptions& global) { return run_slam(*flags, global); }};
 }
 

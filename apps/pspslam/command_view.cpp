@@ -1,5 +1,6 @@
-// `pspslam view`: shows a finished run in the browser. A small HTTP server (cpp-httplib) serves
-// the page in web/ and JSON built once from the run's output files, so nothing of SLAM runs here.
+// `pspslam view`: shows a finished run in the browser. The viewer's HTTP server (viewer/, the
+// one `run --viewer` uses) serves the page in web/ and JSON built once from the run's output
+// files, so nothing of SLAM runs here.
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
@@ -21,9 +22,8 @@
 #include "pspslam/eval/ate.h"
 #include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/trajectory_io.h"
-
-// Last: through <resolv.h> it defines a macro `_res`, which Eigen uses as a parameter name.
-#include <httplib.h>
+#include "pspslam/viewer/endpoint.h"
+#include "pspslam/viewer/web_server.h"
 
 namespace pspslam::cli {
 
@@ -36,34 +36,6 @@ struct ViewOptions {
   std::string viewer = "8080";
   std::string gt_file;
 };
-
-struct Endpoint {
-  std::string host = "127.0.0.1";
-  int port = 8080;
-};
-
-// "[HOST:]PORT"; the last ':' splits, so "[::1]:8080" style IPv6 needs the brackets removed.
-Endpoint parse_endpoint(const std::string& text) {
-  Endpoint endpoint;
-  std::string port_text = text;
-  if (const size_t colon = text.rfind(':'); colon != std::string::npos) {
-    endpoint.host = text.substr(0, colon);
-    if (endpoint.host.size() >= 2 && endpoint.host.front() == '[' && endpoint.host.back() == ']')
-      endpoint.host = endpoint.host.substr(1, endpoint.host.size() - 2);
-    port_text = text.substr(colon + 1);
-  }
-  const bool digits = !port_text.empty() && port_text.size() <= 5 &&
-                      port_text.find_first_not_of("0123456789") == std::string::npos;
-  if (endpoint.host.empty() || !digits || std::stoi(port_text) > 65535) {
-    throw Error("--viewer " + text + ": expected [HOST:]PORT with PORT 0-65535 (0: any free port)");
-  }
-  endpoint.port = std::stoi(port_text);
-  return endpoint;
-}
-
-bool is_loopback(const std::string& host) {
-  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
-}
 
 nlohmann::json poses_json(const Trajectory& trajectory) {
   nlohmann::json poses = nlohmann::json::array();
@@ -174,122 +146,27 @@ RunData load_run(const ViewOptions& options) {
   return data;
 }
 
-std::string content_type(const fs::path& file) {
-  const std::string ext = file.extension().string();
-  if (ext == ".html") return "text/html; charset=utf-8";
-  if (ext == ".js") return "text/javascript; charset=utf-8";
-  if (ext == ".css") return "text/css; charset=utf-8";
-  if (ext == ".json") return "application/json";
-  if (ext == ".png") return "image/png";
-  return "application/octet-stream";
-}
-
-// The file a request path names inside `root`, or nothing. httplib has already percent-decoded
-// the path, so "%2e%2e%2f" arrives as "../" and is refused here like a literal one; a '%' left
-// after decoding (double encoding) or a backslash is refused too. The canonical-prefix check
-// stays as a second wall should a segment test ever miss a case.
-std::optional<fs::path> asset_file(const fs::path& root, const std::string& request_path) {
-  std::string relative = request_path == "/" ? "index.html" : request_path.substr(1);
-  // three.js lives under the npm folder; the page imports it as /vendor/three/...
-  const std::string vendor = "vendor/three/";
-  if (relative.rfind(vendor, 0) == 0)
-    relative = "node_modules/three/" + relative.substr(vendor.size());
-  if (relative.find_first_of("\\%") != std::string::npos ||
-      relative.find('\0') != std::string::npos) {
-    return std::nullopt;
-  }
-  for (const fs::path& part : fs::path(relative)) {
-    if (part == ".." || part == "." || part.is_absolute() || part.has_root_name())
-      return std::nullopt;
-  }
-  std::error_code failure;
-  const fs::path canonical_root = fs::canonical(root, failure);
-  if (failure) return std::nullopt;
-  const fs::path file = fs::weakly_canonical(canonical_root / relative, failure);
-  if (failure) return std::nullopt;
-  const auto [root_end, unused] =
-      std::mismatch(canonical_root.begin(), canonical_root.end(), file.begin(), file.end());
-  if (root_end != canonical_root.end()) return std::nullopt;
-  if (!fs::is_regular_file(file, failure)) return std::nullopt;
-  return file;
-}
-
-// The listening thread; stopping and joining in the destructor means an exception on the main
-// thread can never leave it running.
-class ServerThread {
- public:
-  explicit ServerThread(httplib::Server& server)
-      : server_(server), thread_([this] { server_.listen_after_bind(); }) {}
-  ~ServerThread() {
-    server_.stop();
-    thread_.join();
-  }
-  ServerThread(const ServerThread&) = delete;
-  ServerThread& operator=(const ServerThread&) = delete;
-
- private:
-  httplib::Server& server_;
-  std::thread thread_;
-};
-
 int view(const ViewOptions& options) {
-  const Endpoint endpoint = parse_endpoint(options.viewer);
-  const fs::path web_root = data_dir() / "web";
-  if (!fs::is_regular_file(web_root / "index.html") ||
-      !fs::is_regular_file(web_root / "node_modules/three/build/three.module.js")) {
-    throw Error(web_root.string() +
-                ": the viewer's page or three.js is missing (scripts/install-deps runs 'npm ci' "
-                "in web/)");
-  }
+  parse_endpoint(options.viewer);  // a bad --viewer is told before the run is read
+  WebServer server(data_dir() / "web");
   const RunData data = load_run(options);
-
-  httplib::Server server;
-  const auto json_route = [&server](const std::string& route, const std::string& body) {
-    server.Get(route, [&body](const httplib::Request&, httplib::Response& response) {
-      response.set_content(body, "application/json");
+  const auto json_route = [&server](const std::string& route, std::string body) {
+    auto shared = std::make_shared<const std::string>(std::move(body));
+    server.get(route, [shared](const WebServer::Query&) {
+      return HttpReply{200, "application/json", shared};
     });
   };
   json_route("/api/trajectory", data.trajectory);
   json_route("/api/stats", data.stats);
   json_route("/api/map", data.map);
   json_route("/api/groundtruth", data.ground_truth);
-  server.Get(R"(/.*)", [&web_root](const httplib::Request& request, httplib::Response& response) {
-    const std::optional<fs::path> file = asset_file(web_root, request.path);
-    if (!file) {
-      response.status = 404;
-      response.set_content("not found\n", "text/plain");
-      return;
-    }
-    std::ifstream stream(*file, std::ios::binary);
-    response.set_content(std::string(std::istreambuf_iterator<char>(stream), {}),
-                         content_type(*file).c_str());
-  });
-
-  int port = endpoint.port;
-  if (port == 0) {
-    port = server.bind_to_any_port(endpoint.host.c_str());
-  } else if (!server.bind_to_port(endpoint.host.c_str(), port)) {
-    port = -1;
-  }
-  if (port <= 0) {
-    throw Error("--viewer " + options.viewer + ": cannot listen on " + endpoint.host + ":" +
-                std::to_string(endpoint.port) +
-                " (port in use, or not an address of this machine)");
-  }
-  if (!is_loopback(endpoint.host)) {
-    spdlog::warn("the viewer listens on {}: anyone who can reach this machine can see the run",
-                 endpoint.host);
-  }
   // The guard exists before the address is printed: a Ctrl-C from then on stops the server
   // cleanly instead of killing the process.
   InterruptGuard guard;
-  {
-    ServerThread thread(server);
-    const bool v6 = endpoint.host.find(':') != std::string::npos;
-    std::cout << "viewer: http://" << (v6 ? "[" + endpoint.host + "]" : endpoint.host) << ":"
-              << port << "/  (" << data.poses << " poses; Ctrl-C stops)" << std::endl;
-    while (!interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  const std::string url = server.listen(options.viewer);
+  std::cout << "viewer: " << url << "  (" << data.poses << " poses; Ctrl-C stops)" << std::endl;
+  while (!interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  server.stop();
   clear_interrupt();
   std::cout << "viewer stopped" << std::endl;
   return 0;

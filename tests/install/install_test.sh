@@ -27,7 +27,8 @@ grep -q "loop closing: on" "$work/run.log" ||
 view_pid=$!
 for _ in $(seq 600); do grep -q 'viewer: http' "$work/view.log" && break; sleep 0.1; done
 port=$(sed -n 's|^viewer: http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$work/view.log")
-for asset in / /vendor/three/build/three.module.js /vendor/three/examples/jsm/controls/OrbitControls.js; do
+for asset in / /scene.js /live.html /live.js /vendor/three/build/three.module.js \
+             /vendor/three/examples/jsm/controls/OrbitControls.js; do
   exec 3<> "/dev/tcp/127.0.0.1/$port"
   printf 'GET %s HTTP/1.0\r\n\r\n' "$asset" >&3
   status=$(head -n 1 <&3)

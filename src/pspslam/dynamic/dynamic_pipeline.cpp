@@ -81,6 +81,9 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semant
                                      OrbFeatures& features, DynamicReport& report,
                                      std::vector<KeypointRecord>* dropped) {
   geometry_mask_.release();
+  picture_.regions.release();
+  picture_.tested.clear();
+  picture_.path.clear();
   const std::vector<std::uint8_t>* geometry_flags = nullptr;
   if (geometry_ && prior_pose()) collect_reference_views();
   if (geometry_ && prior_pose() && !views_.empty()) {
@@ -110,6 +113,17 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semant
     geometry_flags_ = std::move(result.keypoint_dynamic);
     geometry_flags = &geometry_flags_;
     geometry_mask_ = std::move(result.dynamic_mask);
+    if (dropped) {
+      // Copies, only for pictures: the stage reuses its buffers on the next frame.
+      picture_.regions = geometry_mask_.clone();
+      for (size_t i = 0; i < result.keypoint_tested.size(); ++i) {
+        if (result.keypoint_tested[i])
+          picture_.tested.push_back(
+              {features.keypoints[i].pt, result.keypoint_tested_dynamic[i] != 0});
+      }
+      for (const Eigen::Vector2f& node : geometry_->last_search_path())
+        picture_.path.emplace_back(node.x(), node.y());
+    }
   }
   fuse_keypoint_flags(features.keypoints, semantic_mask,
                       geometry_flags ? std::span<const std::uint8_t>(*geometry_flags)

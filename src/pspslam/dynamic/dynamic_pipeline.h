@@ -58,6 +58,18 @@ struct KeypointRecord {
   KeypointFate fate = KeypointFate::unmatched;
 };
 
+// What the geometry stage looked at in one frame, for pictures (the live viewer); filled only
+// when keypoint fates are recorded. Positions are distorted image pixels.
+struct GeometryPicture {
+  struct TestedPoint {
+    cv::Point2f position;
+    bool dynamic = false;  // the multi-view test said dynamic
+  };
+  cv::Mat regions;  // grown dynamic regions (CV_8UC1, 255 = dynamic); empty: stage did not run
+  std::vector<TestedPoint> tested;
+  std::vector<cv::Point2f> path;  // the ant colony's path, in walking order (empty: exhaustive)
+};
+
 // What the dynamic-scene stages did for one frame (all zero / -1 with DynamicMode::off).
 struct DynamicReport {
   double flow_ms = 0.0;              // LK matches + compensated homography (eq. 10-11)
@@ -117,6 +129,10 @@ class DynamicPipeline {
   // labels are not). Shared with the semantic thread's result, not copied.
   const cv::Mat& semantic_labels() const { return labels_; }
 
+  // The geometry stage's tested points, path and grown regions of the last remove_dynamic()
+  // that was given `dropped`; empty otherwise.
+  const GeometryPicture& geometry_picture() const { return picture_; }
+
   // Step 6 and the state for the next frame.
   void end_frame(const TrackResult& result, const cv::Mat& depth, const cv::Mat& semantic_mask,
                  DynamicReport& report);
@@ -161,6 +177,7 @@ class DynamicPipeline {
   cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
   cv::Mat geometry_mask_;
   cv::Mat labels_;  // of the mask used for the current frame
+  GeometryPicture picture_;
   std::optional<Pose> last_pose_;
   std::optional<Pose> velocity_;
   std::int64_t last_pose_id_ = -1;

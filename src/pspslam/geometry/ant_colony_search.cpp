@@ -229,6 +229,7 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   result_.tested.assign(n, 0);
   result_.tested_count = result_.dynamic_count = result_.communities = result_.band_rounds =
       result_.last_band_tests = 0;
+  last_phase_ = -1;
   if (n == 0) return result_;
 
   if (params_.strategy == SearchStrategy::exhaustive) {
@@ -240,6 +241,7 @@ const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> poi
   build_grid(points, image_size);
   build_paths(image_size);
   const int phase = params_.alternate_lanes ? static_cast<int>(run_count_++ & 1u) : 0;
+  last_phase_ = phase;
 
   for (int index : priority) {
     if (index < 0 || static_cast<size_t>(index) >= n || result_.tested[index]) continue;

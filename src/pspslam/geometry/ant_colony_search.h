@@ -68,6 +68,13 @@ class DynamicPointSearch {
 
   const AntColonyParams& params() const { return params_; }
 
+  // The path the last run() walked (nodes in walking order, pixels); empty after an exhaustive
+  // run or one without points. For pictures of the search (the live viewer); valid until the
+  // next run.
+  std::span<const Eigen::Vector2f> last_path() const {
+    return last_phase_ < 0 ? std::span<const Eigen::Vector2f>() : path_nodes_[last_phase_];
+  }
+
  private:
   void build_grid(std::span<const Eigen::Vector2f> points, cv::Size image_size);
   void build_paths(cv::Size image_size);
@@ -95,6 +102,7 @@ class DynamicPointSearch {
   // Two phases of the path (lanes shifted by half a lane spacing), used on alternate runs.
   std::vector<Eigen::Vector2f> path_nodes_[2];
   unsigned run_count_ = 0;
+  int last_phase_ = -1;  // phase of the path the last run walked; -1: none
   std::vector<Eigen::Vector2f> community_;
   std::vector<Eigen::Vector2f> hull_;
   std::vector<Eigen::Vector2f> hull_scratch_;

@@ -107,6 +107,8 @@ class GeometryStage {
   GeometryFrameResult process(const GeometryFrameInput& input);
 
   const GeometryParams& params() const { return params_; }
+  // The ant colony's path of the last process() (DynamicPointSearch::last_path).
+  std::span<const Eigen::Vector2f> last_search_path() const { return search_.last_path(); }
 
  private:
   PinholeCamera camera_;

@@ -187,6 +187,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
       {"semantic_wait", to_json(t_semantic_wait)}, {"geometry", to_json(t_geometry)},
       {"geometry_search", to_json(t_search)},      {"flow_homography", to_json(t_flow)},
       {"tracking", to_json(t_tracking)},           {"local_mapping", to_json(t_mapping)}};
+  if (!stats.observer_cpu_ms.empty())
+    json["timing_ms"]["viewer_hooks_cpu"] = to_json(summarize(stats.observer_cpu_ms));
   json["dynamic"] = {{"tested_points", stats.tested_points},
                      {"dynamic_points", stats.dynamic_points},
                      {"masked_keypoints", stats.masked_keypoints},

@@ -54,6 +54,10 @@ class RunStatistics {
   std::vector<double> local_mapping_ms;  // one entry per local BA
   std::vector<double> mask_age_frames;
   std::vector<double> mask_latency_ms;
+  // Thread CPU of the run loop in a RunObserver's hooks per frame (`run --viewer`; a held loop
+  // sleeps, which costs no CPU): what watching costs the frames, apart from the detail recorded
+  // inside System::process for the shown frames.
+  std::vector<double> observer_cpu_ms;
   size_t tested_points = 0;
   size_t dynamic_points = 0;
   size_t masked_keypoints = 0;

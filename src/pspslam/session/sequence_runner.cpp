@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -23,6 +24,12 @@
 
 namespace pspslam {
 namespace {
+
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
 
 // --export-map / --export-dense, after shutdown (local mapping has refined the poses).
 void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, const Map& map,
@@ -148,6 +155,15 @@ RunOutcome SequenceRunner::run() {
     }
     const size_t i = frame.index;
     check_frame_size(frame);
+    double observer_cpu = 0.0;
+    if (observer_) {
+      const double cpu_before = thread_cpu_ms();
+      const RunObserver::Detail detail = observer_->wants_detail();
+      observer_cpu += thread_cpu_ms() - cpu_before;
+      const bool overlays = images_.writes_overlays();
+      system_->set_record_keypoint_fates(overlays || detail.fates,
+                                         overlays || detail.masked_keypoints);
+    }
     const FrameReport report = system_->process(frame);
     const TrackResult& result = report.tracking;
     spdlog::debug(
@@ -169,7 +185,13 @@ RunOutcome SequenceRunner::run() {
     statistics_.add_frame(i, report, mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
     ba_ms_before = mapping.local_ba_ms_total;
     progress.update(statistics_.processed(), statistics_.realtime_dropped());
+    if (observer_) {
+      const double cpu_before = thread_cpu_ms();
+      observer_->frame_done({frame, report, *system_, statistics_, mapping, estimate_, frames_});
+      statistics_.observer_cpu_ms.push_back(observer_cpu + thread_cpu_ms() - cpu_before);
+    }
   }
+  if (observer_) observer_->run_ended();
   progress.finish();
   system_->shutdown();
   if (!options_.outputs.save_map.empty()) {

@@ -11,6 +11,7 @@
 #include "pspslam/io/frame_source.h"
 #include "pspslam/session/frame_images.h"
 #include "pspslam/session/frame_log.h"
+#include "pspslam/session/run_observer.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/system/map_export.h"
@@ -48,6 +49,9 @@ class SequenceRunner {
   SequenceRunner(const SequenceRunner&) = delete;
   SequenceRunner& operator=(const SequenceRunner&) = delete;
 
+  // Shows every frame to `observer` (the live viewer; not owned, must outlive run()); null: none.
+  void watch(RunObserver* observer) { observer_ = observer; }
+
   // Processes the frames (until the end, max_frames or an interrupt), shuts the system down and
   // writes the final outputs and the report. Call once.
   RunOutcome run();
@@ -70,6 +74,7 @@ class SequenceRunner {
   std::optional<MapExporter> exporter_;  // with --export-map / --export-dense
   RunStatistics statistics_;
   Trajectory estimate_;
+  RunObserver* observer_ = nullptr;
 };
 
 }  // namespace pspslam

@@ -308,7 +308,7 @@ FrameReport System::process(const RgbdFrame& frame) {
     }
   }
   std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
-  if (fates) record_fates_before_removal(gray, semantic_mask, *fates);
+  if (fates && record_masked_fates_) record_fates_before_removal(gray, semantic_mask, *fates);
   dynamic_->remove_dynamic(depth, semantic_mask, features, report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), depth);
@@ -362,6 +362,10 @@ void System::wait_for_local_mapping_if_synchronous() {
 }
 
 cv::Mat System::last_dynamic_mask() const { return dynamic_ ? dynamic_->fused_mask() : cv::Mat(); }
+
+const GeometryPicture* System::last_geometry_picture() const {
+  return dynamic_ ? &dynamic_->geometry_picture() : nullptr;
+}
 
 cv::Mat System::last_semantic_labels() const {
   return dynamic_ ? dynamic_->semantic_labels() : cv::Mat();

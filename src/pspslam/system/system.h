@@ -140,6 +140,19 @@ class System {
   // without semantics or a mask. Shared, not copied.
   cv::Mat last_semantic_labels() const;
 
+  // The geometry stage's picture of the frame process() handled last (tested points, path,
+  // grown regions); empty unless keypoint fates were recorded for that frame; null with
+  // DynamicMode::off.
+  const GeometryPicture* last_geometry_picture() const;
+  // Turns SystemOptions::record_keypoint_fates on or off from the next frame on: the live viewer
+  // pays for them only on the frames it shows. `masked` = also the keypoints the semantic mask
+  // kept from being extracted, which costs a second, unmasked extraction (a real-time viewer
+  // leaves them out and shows the mask instead).
+  void set_record_keypoint_fates(bool record, bool masked = true) {
+    record_keypoint_fates_ = record;
+    record_masked_fates_ = masked;
+  }
+
   // Writes the map (persistence/map_file.h); call after shutdown(). Throws pspslam::Error.
   // Returns the number of keyframes and map points written.
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
@@ -184,7 +197,8 @@ class System {
   std::uint64_t next_frame_id_ = 0;
   bool synchronous_local_mapping_ = false;
   bool record_keypoint_fates_ = false;
-  OrbFeatures unmasked_features_;  // record_keypoint_fates only: reused every frame
+  bool record_masked_fates_ = true;  // with record_keypoint_fates_: the second extraction too
+  OrbFeatures unmasked_features_;    // record_keypoint_fates only: reused every frame
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker and map go away.
   std::unique_ptr<DynamicPipeline> dynamic_;

@@ -1,0 +1,117 @@
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pspslam/core/types.h"
+#include "pspslam/session/keypoint_overlay.h"
+#include "pspslam/session/run_observer.h"
+#include "pspslam/viewer/web_server.h"
+
+namespace pspslam {
+
+struct LiveViewerOptions {
+  std::string endpoint = "127.0.0.1:8080";  // --viewer [HOST:]PORT
+  std::filesystem::path web_root;           // the page's folder (core/shared_paths.h data_dir)
+  // Frame snapshots at most this often, the map's at most every map_interval: what the run
+  // loop pays for the viewer is bounded by these, not by how often a browser asks.
+  std::chrono::milliseconds interval{250};
+  std::chrono::milliseconds map_interval{1000};
+  int image_width = 480;  // frames are sent JPEG at this width (never enlarged)
+  bool start_paused = false;
+  // A real-time feed keeps coming whatever the viewer does: pause is refused (the frames would
+  // be dropped by the source, not held), and the keypoints the semantic mask removed are not
+  // shown (finding them costs a second ORB extraction on the tracking thread; the label overlay
+  // shows the mask instead).
+  bool realtime = false;
+  std::filesystem::path ground_truth;  // TUM file aligned onto the estimate; empty: none
+  OverlayClasses classes;              // the segmentation's classes, for the label colours
+  std::string title;                   // the sequence or camera, shown on the page
+};
+
+// `pspslam run --viewer`: serves the live page (web/live.html) and what it shows, a snapshot of
+// the current frame (JPEG + label / grown-region overlays as PNG + keypoints as JSON) and of the
+// map, pushed to the page by Server-Sent Events. The run loop only copies what a snapshot needs
+// (image headers, keypoint records, map point positions) when one is due; resizing, encoding and
+// JSON happen on the viewer's own encoder thread, newest snapshot wins (one pending at most, so
+// a slow encoder or browser drops snapshots, never frames). Pause / resume / step hold the run
+// loop between frames (deterministic runs only).
+class LiveViewer final : public RunObserver {
+ public:
+  // Starts the server (prints nothing; url() says where) and the encoder thread. Throws
+  // pspslam::Error when the page is missing or the address cannot be bound.
+  explicit LiveViewer(LiveViewerOptions options);
+  ~LiveViewer() override;
+  LiveViewer(const LiveViewer&) = delete;
+  LiveViewer& operator=(const LiveViewer&) = delete;
+
+  const std::string& url() const { return url_; }
+
+  Detail wants_detail() override;
+  void frame_done(const FrameView& view) override;
+  void run_ended() override;
+
+  // The controls of the page (also reachable as POST /api/pause, /api/resume, /api/step).
+  // False when refused (--realtime, or the run is over).
+  bool pause();
+  bool resume();
+  bool step();
+
+  // Snapshots published so far (frame images encoded); for tests.
+  std::uint64_t frames_published() const;
+
+ private:
+  struct FrameSnapshot;
+  struct MapSnapshot;
+  using Clock = std::chrono::steady_clock;
+
+  void encode_loop();
+  void publish_frame(const FrameSnapshot& snapshot);
+  void publish_map(const MapSnapshot& snapshot);
+  std::string state_json() const;  // under mutex_
+  std::string event_json() const;  // under mutex_: state + the newest frame's JSON
+  std::optional<std::string> next_event(std::uint64_t& last);
+  HttpReply control(bool (LiveViewer::*action)());
+
+  LiveViewerOptions options_;
+  Trajectory ground_truth_;
+  WebServer server_;
+  std::string url_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable work_;     // the encoder: a snapshot is pending, or closing
+  std::condition_variable changed_;  // event streams and the paused run loop
+  std::unique_ptr<FrameSnapshot> pending_frame_;
+  std::unique_ptr<MapSnapshot> pending_map_;
+  bool closing_ = false;
+  // Control state.
+  bool paused_ = false;
+  int steps_ = 0;          // frames the paused loop may still process
+  bool waiting_ = false;   // the run loop is held now
+  bool ended_ = false;     // the frame loop is over
+  bool detail_ = false;    // the frame being processed records its keypoint fates
+  size_t held_frame_ = 0;  // index of the frame the loop is held after
+  Clock::time_point last_frame_snapshot_{};
+  Clock::time_point last_map_snapshot_{};
+  std::uint64_t last_map_keyframes_ = 0;
+  // Published (read by the server threads; replaced, never modified, so a reply shares them).
+  std::uint64_t event_ = 0;  // any change: frame, map or state
+  std::uint64_t frame_version_ = 0;
+  std::uint64_t map_version_ = 0;
+  std::shared_ptr<const std::string> frame_json_, jpeg_, labels_png_, regions_png_, map_json_;
+  // fps over the snapshots: frames processed between two of them over the time between.
+  std::optional<std::pair<size_t, Clock::time_point>> fps_reference_;
+  double fps_ = 0.0;
+
+  std::thread encoder_;  // last: started once everything above exists
+};
+
+}  // namespace pspslam

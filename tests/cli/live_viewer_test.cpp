@@ -1,0 +1,263 @@
+// `pspslam run --viewer` end to end: a real browser (headless chromium driven by playwright-core,
+// tests/cli/live_page.mjs) watches a synthetic run, pauses and steps it; path traversal and a
+// request flood against a running run; Ctrl-C with an event stream open.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pspslam/io/trajectory_io.h"
+#include "support/test_support.h"
+
+// Last: through <resolv.h> it defines a macro `_res`, which Eigen uses as a parameter name.
+#include <httplib.h>
+
+namespace pspslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& file) {
+  std::ifstream stream(file);
+  return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// A synthetic sequence with two moving bodies, made once per frame count.
+fs::path sequence(int frames) {
+  const fs::path dir = testing::make_temp_dir("live_seq") / ("seq" + std::to_string(frames));
+  std::string output;
+  EXPECT_EQ(testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " synth -q --out " + dir.string() +
+                                   " --frames " + std::to_string(frames) + " --bodies 2 --seed 5",
+                               &output),
+            0)
+      << output;
+  return dir;
+}
+
+// `pspslam run ... --viewer 127.0.0.1:0` in the background; the port is read from its output.
+class LiveRun {
+ public:
+  LiveRun(const fs::path& seq, const std::string& flags)
+      : dir_(testing::make_temp_dir("live_run")) {
+    std::string pid;
+    testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run -q --sequence " + seq.string() +
+                           " --out " + out().string() + " --viewer 127.0.0.1:0 " + flags + " > '" +
+                           log_file().string() + "' 2>&1 & echo $!",
+                       &pid);
+    pid_ = std::stoi(pid);
+    const std::string marker = "http://127.0.0.1:";
+    for (int i = 0; i < 1200 && !contains(log(), marker); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const std::string text = log();
+    if (const size_t at = text.find(marker); at != std::string::npos)
+      port_ = std::stoi(text.substr(at + marker.size()));
+  }
+  ~LiveRun() {
+    if (running()) kill(pid_, SIGKILL);
+  }
+  LiveRun(const LiveRun&) = delete;
+  LiveRun& operator=(const LiveRun&) = delete;
+
+  fs::path out() const { return dir_ / "out"; }
+  fs::path log_file() const { return dir_ / "log"; }
+  std::string log() const { return read_text(log_file()); }
+  int port() const { return port_; }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/"; }
+  bool running() const { return pid_ > 0 && kill(pid_, 0) == 0 && !contains(log(), "stats:"); }
+  void signal(int number) const { kill(pid_, number); }
+  // Waits for the process to end; false after `seconds`.
+  bool wait(int seconds) const {
+    for (int i = 0; i < seconds * 10; ++i) {
+      if (kill(pid_, 0) != 0) return true;
+      // The shell's child is not ours to reap; a zombie counts as ended once the log is final.
+      if (contains(log(), "stats:") || contains(log(), "interrupted after")) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return false;
+  }
+
+ private:
+  fs::path dir_;
+  int pid_ = 0;
+  int port_ = 0;
+};
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream stream(file);
+  return nlohmann::json::parse(stream);
+}
+
+TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
+  std::string found;
+  if (testing::run_shell("command -v chromium && command -v node", &found) != 0) {
+    GTEST_SKIP() << "chromium or node is not installed (scripts/install-deps installs both)";
+  }
+  const fs::path playwright = fs::path(PSPSLAM_SOURCE_DIR) / "web/node_modules/playwright-core";
+  if (!fs::is_regular_file(playwright / "index.mjs")) {
+    GTEST_SKIP() << playwright.string() << " missing (scripts/install-deps runs npm ci in web/)";
+  }
+  constexpr int kFrames = 200;
+  LiveRun run(sequence(kFrames), "--viewer-paused --viewer-interval 100");
+  ASSERT_GT(run.port(), 0) << run.log();
+  const fs::path shot = testing::make_temp_dir("live_shot") / "live.png";
+  std::string output;
+  testing::run_shell("timeout 600 node " + fs::path(PSPSLAM_SOURCE_DIR).string() +
+                         "/tests/cli/live_page.mjs " + playwright.string() + " " + run.url() + " " +
+                         shot.string() + " 2>&1",
+                     &output);
+  const size_t brace = output.rfind("\n{");
+  ASSERT_NE(output.find('{'), std::string::npos) << output;
+  const nlohmann::json seen =
+      nlohmann::json::parse(output.substr(brace == std::string::npos ? output.find('{') : brace));
+  ASSERT_FALSE(seen.contains("error")) << seen.dump() << "\n" << run.log();
+  EXPECT_FALSE(seen.contains("page_error")) << seen.dump();
+  // Held at the first frame, and it stays there.
+  EXPECT_EQ(seen["start"], 0);
+  EXPECT_EQ(seen["start_later"], 0);
+  // One step: exactly one more frame, then held again.
+  EXPECT_EQ(seen["step"], 1);
+  EXPECT_EQ(seen["step_later"], 1);
+  // Running, the map and the dynamic keypoints showed up.
+  EXPECT_GT(seen["map_points"].get<int>(), 100);
+  EXPECT_GE(seen["keyframes"].get<int>(), 2);
+  EXPECT_GT(seen["dynamic_seen"].get<int>(), 0);
+  // Pause stops the frame counter; step moves it by one.
+  EXPECT_EQ(seen["paused_later"], seen["paused"]);
+  EXPECT_EQ(seen["paused_step"].get<int>(), seen["paused"].get<int>() + 1);
+  EXPECT_LT(seen["paused"].get<int>(), kFrames - 1);
+  EXPECT_TRUE(seen.value("finished", false));
+
+  ASSERT_TRUE(run.wait(120)) << run.log();
+  EXPECT_EQ(read_tum_trajectory(run.out() / "trajectory.txt").size(), size_t{kFrames});
+
+  ASSERT_TRUE(fs::is_regular_file(shot));
+  const cv::Mat image = cv::imread(shot.string());
+  ASSERT_FALSE(image.empty());
+  EXPECT_EQ(image.cols, 1400);
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(image, mean, deviation);
+  EXPECT_GT(deviation[0], 10.0);  // the frame, the panel and the map, not a blank page
+}
+
+TEST(CliLiveViewer, TraversalRefusedAndFloodDoesNotStallTracking) {
+  constexpr int kFrames = 150;
+  const fs::path seq = sequence(kFrames);
+  const auto start = std::chrono::steady_clock::now();
+  LiveRun run(seq, "");
+  ASSERT_GT(run.port(), 0) << run.log();
+  httplib::Client client("127.0.0.1", run.port());
+  client.set_url_encode(false);  // sent byte for byte
+  for (const std::string path :
+       {"/../../etc/passwd", "/%2e%2e%2f%2e%2e%2fetc%2fpasswd", "/..%2f..%2f..%2fetc/passwd",
+        "/%2E%2E/%2E%2E/etc/passwd", "/%252e%252e%252f%252e%252e%252fetc%252fpasswd",
+        "/vendor/three/%2e%2e/%2e%2e/%2e%2e/%2e%2e/etc/passwd", "/..\\..\\etc\\passwd",
+        "/api/live/../../../etc/passwd", "/%2e%2e/CMakeLists.txt"}) {
+    const auto response = client.Get(path.c_str());
+    ASSERT_TRUE(response) << path;
+    EXPECT_TRUE(response->status == 404 || response->status == 400)
+        << path << ": " << response->status;
+    EXPECT_FALSE(contains(response->body, "root:")) << path;
+  }
+  // 1,000 requests from four connections while the run goes.
+  std::atomic<int> answered{0};
+  std::vector<std::thread> flood;
+  for (int t = 0; t < 4; ++t) {
+    flood.emplace_back([&, t] {
+      httplib::Client c("127.0.0.1", run.port());
+      const char* paths[] = {"/api/live/state", "/api/live/frame.jpg", "/", "/api/live/map"};
+      for (int i = 0; i < 250; ++i) {
+        if (c.Get(paths[(i + t) % 4])) ++answered;
+      }
+    });
+  }
+  for (std::thread& thread : flood) thread.join();
+  EXPECT_EQ(answered.load(), 1000);
+  EXPECT_TRUE(run.running()) << "the run ended before the flood did: the test proves nothing";
+  ASSERT_TRUE(run.wait(600)) << run.log();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Generous: ~15 s on an idle 2-core machine; a stalled tracker would not finish.
+  EXPECT_LT(seconds, 400.0);
+  const nlohmann::json stats = read_json(run.out() / "stats.json");
+  EXPECT_EQ(stats["frames"], kFrames);
+  EXPECT_EQ(stats["lost_frames"], 0);
+  EXPECT_EQ(read_tum_trajectory(run.out() / "trajectory.txt").size(), size_t{kFrames});
+}
+
+// Polls /api/live/state until the run loop is held after frame `index`.
+bool wait_held(httplib::Client& client, int index) {
+  for (int i = 0; i < 1200; ++i) {
+    if (const auto response = client.Get("/api/live/state"); response && response->status == 200) {
+      const nlohmann::json state = nlohmann::json::parse(response->body)["state"];
+      if (state["waiting"] == true && state["held_frame"] == index) return true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+TEST(CliLiveViewer, InterruptStopsServerWithEventStreamOpen) {
+  LiveRun run(sequence(60), "--viewer-paused");
+  ASSERT_GT(run.port(), 0) << run.log();
+  httplib::Client client("127.0.0.1", run.port());
+  // Three steps from the held first frame, each one frame.
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(wait_held(client, i)) << run.log();
+    const auto response = client.Post("/api/step");
+    ASSERT_TRUE(response);
+    EXPECT_EQ(response->status, 200);
+  }
+  ASSERT_TRUE(wait_held(client, 3)) << run.log();
+  // An open event stream must not keep the server from stopping.
+  std::atomic<int> events{0};
+  std::thread stream([&] {
+    httplib::Client c("127.0.0.1", run.port());
+    c.set_read_timeout(120, 0);
+    c.Get("/api/live/events", [&](const char*, size_t) {
+      ++events;
+      return true;
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  run.signal(SIGINT);
+  const bool ended = run.wait(120);
+  stream.join();
+  ASSERT_TRUE(ended) << run.log();
+  EXPECT_GT(events.load(), 0);
+  EXPECT_TRUE(contains(run.log(), "interrupted after")) << run.log();
+  const Trajectory trajectory = read_tum_trajectory(run.out() / "trajectory.txt");
+  // Frames 0-3 were processed; the interrupt came while the loop was held after frame 3.
+  EXPECT_EQ(trajectory.size(), 4u);
+  EXPECT_TRUE(fs::is_regular_file(run.out() / "stats.json"));
+}
+
+TEST(CliLiveViewer, RealtimeRefusesPause) {
+  LiveRun run(sequence(60), "--realtime");
+  ASSERT_GT(run.port(), 0) << run.log();
+  httplib::Client client("127.0.0.1", run.port());
+  const auto response = client.Post("/api/pause");
+  ASSERT_TRUE(response);
+  EXPECT_EQ(response->status, 409);
+  EXPECT_TRUE(contains(response->body, "--realtime")) << response->body;
+  ASSERT_TRUE(run.wait(300)) << run.log();
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -38,6 +38,12 @@ struct OrbConfig {
   int n_levels = 8;
   int initial_fast_threshold = 20;
   int min_fast_threshold = 7;
+  // When an extraction mask removes part of the image, keep the kept-keypoint count near
+  // n_features: a pyramid level with fewer unmasked corners than its share is searched again at
+  // min_fast_threshold, and what it still lacks goes to the levels that have corners to spare
+  // (ORB-SLAM2 has neither: a frame half covered by people kept ~550 of 1000 keypoints). Frames
+  // without masked pixels are extracted exactly as before. YAML key `mask_compensation`.
+  bool mask_compensation = true;
 };
 
 struct SystemConfig {

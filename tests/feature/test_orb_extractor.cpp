@@ -422,33 +422,41 @@ int keypoints_on_mask(const std::vector<cv::KeyPoint>& keypoints, const cv::Mat&
 }
 
 // A crowd as bonn_crowd_dev's frames 310-326 have it: people over the middle of the image and
-// its lower part, 72 % of the pixels: only a strip at each side, above the floor, is free.
+// its lower part, 82 % of the pixels: only a strip at each side, above the floor, is free.
 cv::Mat make_crowd_mask(cv::Size size) {
   cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
-  const int left = size.width * 20 / 100;
-  const int right = size.width * 80 / 100;
+  const int left = size.width * 15 / 100;
+  const int right = size.width * 85 / 100;
   mask(cv::Rect(left, 0, right - left, size.height)).setTo(255);
-  const int floor_top = size.height * 7 / 10;
+  const int floor_top = size.height * 6 / 10;
   mask(cv::Rect(0, floor_top, size.width, size.height - floor_top)).setTo(255);
   return mask;
 }
 
-TEST(OrbExtractor, MaskCompensationKeepsTheCountWhenMostOfTheImageIsMasked) {
-  const cv::Mat image = make_textured_image();
-  const cv::Mat mask = make_crowd_mask(image.size());
-  const double masked = cv::countNonZero(mask) / static_cast<double>(mask.total());
-  ASSERT_GT(masked, 0.65);
-  ASSERT_LT(masked, 0.75);
+TEST(OrbExtractor, MaskCompensationKeepsTheCountWhenHalfTheImageIsMasked) {
+  // The textured left half is masked (the people); the free right half is a low-contrast copy
+  // (a plain wall): only its sparse bright marks reach the initial FAST threshold, so the
+  // per-level shares alone cannot be filled there.
+  cv::Mat image = make_textured_image();
+  cv::Mat wall = image(cv::Rect(320, 0, 320, 480));
+  wall.convertTo(wall, CV_8UC1, 0.06, 0.94 * 128.0);
+  // A few strong corners (picture hooks, sockets) in every FAST cell, so that no cell of the wall
+  // is empty and ORB-SLAM2's per-cell fallback to the minimum threshold never starts there.
+  for (int y = 10; y < wall.rows - 10; y += 24) {
+    for (int x = 10; x < wall.cols - 10; x += 24) wall(cv::Rect(x, y, 4, 4)).setTo(255);
+  }
+  cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 320, 480)).setTo(255);
 
-  OrbConfig plain_config;
-  plain_config.mask_compensation = false;
-  OrbExtractor plain(plain_config);
-  OrbExtractor compensated{OrbConfig{}};
+  OrbExtractor plain{OrbConfig{}};  // the default: no compensation
+  OrbConfig compensated_config;
+  compensated_config.mask_compensation = true;
+  OrbExtractor compensated(compensated_config);
   OrbFeatures plain_features;
   OrbFeatures features;
   plain.extract(image, mask, plain_features);
   compensated.extract(image, mask, features);
-  std::printf("%.0f%% masked: %zu keypoints without compensation, %zu with\n", 100.0 * masked,
+  std::printf("half masked: %zu keypoints without compensation, %zu with\n",
               plain_features.keypoints.size(), features.keypoints.size());
   // Within 5 % of the 1000 wanted, where the per-level shares alone fall clearly short.
   EXPECT_GE(features.keypoints.size(), 950u);
@@ -471,10 +479,10 @@ TEST(OrbExtractor, MaskCompensationOnARealFrame) {
   // Frame 318 of bonn_crowd_dev: blank walls and floor where the people are not.
   const cv::Mat image = load_bonn_gray_frame(shared, 318);
   const cv::Mat mask = make_crowd_mask(image.size());
-  OrbConfig plain_config;
-  plain_config.mask_compensation = false;
-  OrbExtractor plain(plain_config);
-  OrbExtractor compensated{OrbConfig{}};
+  OrbExtractor plain{OrbConfig{}};  // the default: no compensation
+  OrbConfig compensated_config;
+  compensated_config.mask_compensation = true;
+  OrbExtractor compensated(compensated_config);
   OrbFeatures plain_features;
   OrbFeatures features;
   plain.extract(image, mask, plain_features);
@@ -488,10 +496,10 @@ TEST(OrbExtractor, MaskCompensationOnARealFrame) {
 
 TEST(OrbExtractor, MaskCompensationChangesNothingWithoutMaskedPixels) {
   const cv::Mat image = make_textured_image();
-  OrbConfig plain_config;
-  plain_config.mask_compensation = false;
-  OrbExtractor plain(plain_config);
-  OrbExtractor compensated{OrbConfig{}};
+  OrbExtractor plain{OrbConfig{}};  // the default: no compensation
+  OrbConfig compensated_config;
+  compensated_config.mask_compensation = true;
+  OrbExtractor compensated(compensated_config);
   const cv::Mat empty_mask(image.size(), CV_8UC1, cv::Scalar(0));
   for (const cv::Mat& mask : {cv::Mat(), empty_mask}) {
     OrbFeatures plain_features;

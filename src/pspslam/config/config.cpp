@@ -137,10 +137,9 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "n_levels" << YAML::Value << config.orb.n_levels;
   out << YAML::Key << "initial_fast_threshold" << YAML::Value << config.orb.initial_fast_threshold;
   out << YAML::Key << "min_fast_threshold" << YAML::Value << config.orb.min_fast_threshold;
-  // Written only when switched off, so that sequences rendered by this build still load in
+  // Written only when switched on, so that sequences rendered by this build still load in
   // builds that predate the key (the accuracy panel runs both on the same sequences).
-  if (!config.orb.mask_compensation)
-    out << YAML::Key << "mask_compensation" << YAML::Value << false;
+  if (config.orb.mask_compensation) out << YAML::Key << "mask_compensation" << YAML::Value << true;
   out << YAML::EndMap;
   out << YAML::EndMap;
   std::ofstream stream(file);

@@ -306,12 +306,13 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
   build_pyramid(gray);
 
   for (int level = 0; level < levels(); ++level) detect_candidates(level, ignore_mask);
-  // Mask compensation: a mask over most of the image leaves the levels fewer corners than their
-  // shares (bonn_crowd_dev, people over 55-72 % of frames 310-326: 550-980 of 1000 kept, and the
-  // semantic-only error tripled there). A short level is searched again at the minimum
-  // threshold, then what is still missing goes to the levels with corners to spare, so that the
-  // count stays near n_features while the budget follows where static texture is. Frames
-  // without masked pixels skip this and are extracted exactly as without compensation.
+  // Mask compensation (OrbConfig::mask_compensation, off by default): a mask over most of the
+  // image leaves the levels fewer corners than their shares (bonn_crowd_dev, people over
+  // 55-72 % of frames 310-326: 548-983 of 1000 kept, where the semantic-only error peaks). A
+  // short level is searched again at the minimum threshold, then what is still missing goes to
+  // the levels with corners to spare, so that the count stays near n_features. Measured there,
+  // it keeps the count but costs accuracy in every mode (docs/benchmarks.md, issue #18 item 3).
+  // Frames without masked pixels skip this and are extracted exactly as without compensation.
   level_budget_ = features_per_level_;
   if (config_.mask_compensation && !ignore_mask.empty() && cv::countNonZero(ignore_mask) > 0) {
     for (int level = 0; level < levels(); ++level) {

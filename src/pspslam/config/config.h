@@ -43,9 +43,8 @@ struct OrbConfig {
   // min_fast_threshold, and what it still lacks goes to the levels that have corners to spare
   // (ORB-SLAM2 has neither: a frame 70 % covered by people kept ~580 of 1000 keypoints). Frames
   // without masked pixels are extracted exactly as before. YAML key `mask_compensation`. Off by
-  // default: on bonn_crowd_dev it keeps the count but makes every mode less accurate (likely
-  // because the extra corners are weak ones or lie on parts of people the network missed;
-  // docs/benchmarks.md, issue #18 item 3).
+  // default: on bonn_crowd_dev it keeps the count but makes every mode less accurate (why is
+  // not established; docs/benchmarks.md, issue #18 item 3).
   bool mask_compensation = false;
 };
 

@@ -237,6 +237,7 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   size_t count = 0;
   while (const std::optional<RgbdFrame> frame = all.next()) {
     EXPECT_EQ(frame->index, count++);
+    EXPECT_FALSE(frame->arrival) << "an unpaced frame has no arrival to measure latency from";
   }
   EXPECT_EQ(count, 15u);
   EXPECT_EQ(all.stats().dropped, 0u);
@@ -246,7 +247,16 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   SequenceSource paced(open_sequence_with_config(dir / "seq", std::nullopt, nullptr), 0, true);
   size_t delivered = 0;
   size_t last = 0;
+  std::optional<std::chrono::steady_clock::time_point> first_arrival;
   while (const std::optional<RgbdFrame> frame = paced.next()) {
+    // A frame arrives when it is due (10 ms per frame from the first), even when the busy
+    // consumer takes it later: that wait is part of its latency.
+    ASSERT_TRUE(frame->arrival);
+    if (!first_arrival) first_arrival = frame->arrival;
+    const double due_ms =
+        std::chrono::duration<double, std::milli>(*frame->arrival - *first_arrival).count();
+    EXPECT_NEAR(due_ms, 10.0 * static_cast<double>(frame->index), 1e-3) << frame->index;
+    EXPECT_LE(*frame->arrival, std::chrono::steady_clock::now());
     // Skips at least one frame each time, except where it reaches the last frame.
     if (delivered++ > 0 && frame->index + 1 < 20) {
       EXPECT_GT(frame->index, last + 1);

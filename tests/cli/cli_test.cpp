@@ -549,6 +549,33 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
   EXPECT_EQ(stats["frames"], 3);
 }
 
+// stats.json `latency`: with --realtime every processed frame has its arrival-to-pose time
+// (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
+TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
+  const auto dir = testing::make_temp_dir("cli_latency");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 30 --bodies 0 --seed 3");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const auto latency = [&](const std::string& name, const std::string& flags) {
+    const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                             (dir / name).string() + " --dynamic off " + flags);
+    EXPECT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / name / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    return std::pair{stats["latency"], stats["frames"].get<int>()};
+  };
+  const auto [realtime, processed] = latency("realtime", "--realtime");
+  EXPECT_EQ(realtime["arrival_to_pose_ms"]["count"].get<int>(), processed);
+  const double median = realtime["arrival_to_pose_ms"]["median"].get<double>();
+  EXPECT_GT(median, 0.0);
+  EXPECT_GE(realtime["arrival_to_pose_ms"]["p99"].get<double>(), median);
+  EXPECT_GE(realtime["arrival_to_pose_ms"]["max"].get<double>(),
+            realtime["arrival_to_pose_ms"]["p99"].get<double>());
+  const auto [deterministic, frames] = latency("deterministic", "");
+  EXPECT_EQ(frames, 30);
+  EXPECT_EQ(deterministic["arrival_to_pose_ms"]["count"].get<int>(), 0);
+}
+
 // A mistyped config key is named, with the key it probably meant.
 TEST(CliRun, MistypedConfigKeyIsNamedWithASuggestion) {
   const auto dir = make_sequence("cli_typo", false);

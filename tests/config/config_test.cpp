@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
@@ -68,6 +70,7 @@ TEST(Config, SaveLoadRoundTrip) {
   config.orb.n_levels = 6;
   config.orb.initial_fast_threshold = 25;
   config.orb.min_fast_threshold = 9;
+  config.orb.mask_compensation = true;
   save_config(dir / "saved.yaml", config);
   const SystemConfig loaded = load_config(dir / "saved.yaml");
   EXPECT_EQ(loaded.camera.name, config.camera.name);
@@ -90,6 +93,14 @@ TEST(Config, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded.orb.n_levels, 6);
   EXPECT_EQ(loaded.orb.initial_fast_threshold, 25);
   EXPECT_EQ(loaded.orb.min_fast_threshold, 9);
+  EXPECT_TRUE(loaded.orb.mask_compensation);
+  // Off (the default) is not written, so configs written here load in builds without the key.
+  config.orb.mask_compensation = false;
+  save_config(dir / "saved_off.yaml", config);
+  std::ifstream saved(dir / "saved_off.yaml");
+  const std::string text((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("mask_compensation"), std::string::npos) << text;
+  EXPECT_FALSE(load_config(dir / "saved_off.yaml").orb.mask_compensation);
 }
 
 TEST(Config, AllPresetsLoad) {
@@ -125,6 +136,7 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
   EXPECT_EQ(config.camera.pinhole.fy, 501.25);
   EXPECT_EQ(config.camera.pinhole.distortion[4], 0.0);
   EXPECT_EQ(config.orb.n_features, 1000);
+  EXPECT_FALSE(config.orb.mask_compensation);
   // Without the key, depth is weighed as ORB-SLAM2 does (virtual right coordinate).
   EXPECT_EQ(config.camera.depth_noise, CameraConfig::DepthNoise::none);
 }

@@ -67,5 +67,48 @@ TEST(QuadtreeDistributor, KeepsStrongestPerNodeAndIsDeterministic) {
   for (std::size_t i = 0; i < again.size(); ++i) EXPECT_EQ(again[i].pt, selected[i].pt);
 }
 
+TEST(ShareFeatureBudget, ShortLevelsKeepWhatTheyHaveAndTheRestGoesToLevelsWithCorners) {
+  // The default shares of 1000 features on 8 levels; levels 3-7 have fewer corners than that.
+  const std::vector<int> shares{217, 181, 151, 126, 105, 87, 73, 60};
+  const std::vector<int> available{5000, 260, 900, 40, 30, 0, 12, 7};
+  std::vector<int> budgets(shares.size(), -1);
+  share_feature_budget(shares, available, budgets);
+  int total = 0;
+  for (std::size_t l = 0; l < shares.size(); ++l) {
+    EXPECT_LE(budgets[l], available[l]) << l;
+    total += budgets[l];
+  }
+  EXPECT_EQ(total, 1000);
+  // Short levels keep all they have; level 1 is capped by its 260 corners; the 326 features that
+  // levels 1 and 3-7 cannot use (1000 - 674 after the first round) go to levels 0, 1 and 2.
+  EXPECT_EQ(budgets[3], 40);
+  EXPECT_EQ(budgets[4], 30);
+  EXPECT_EQ(budgets[5], 0);
+  EXPECT_EQ(budgets[6], 12);
+  EXPECT_EQ(budgets[7], 7);
+  EXPECT_EQ(budgets[1], 260);
+  EXPECT_GT(budgets[0], shares[0]);
+  EXPECT_GT(budgets[2], shares[2]);
+  // Level 0 has the larger share, so it takes the larger part of what is left.
+  EXPECT_GT(budgets[0] - shares[0], budgets[2] - shares[2]);
+}
+
+TEST(ShareFeatureBudget, UnchangedWhenEveryLevelCanFillItsShareAndCappedByWhatExists) {
+  const std::vector<int> shares{217, 181, 151, 126, 105, 87, 73, 60};
+  std::vector<int> budgets(shares.size());
+  share_feature_budget(shares, std::vector<int>(shares.size(), 10000), budgets);
+  EXPECT_EQ(budgets, shares);
+  // Fewer corners than features in total: every level takes all it has.
+  const std::vector<int> few{100, 90, 80, 70, 60, 50, 40, 30};
+  share_feature_budget(shares, few, budgets);
+  EXPECT_EQ(budgets, few);
+  // A single spare feature is not lost to rounding.
+  const std::vector<int> almost{217, 181, 151, 126, 105, 87, 73, 59};
+  std::vector<int> more = almost;
+  more[0] += 1;
+  share_feature_budget(shares, more, budgets);
+  EXPECT_EQ(budgets, more);
+}
+
 }  // namespace
 }  // namespace pspslam

@@ -23,6 +23,19 @@ TEST(RunStatistics, TimingSummaryIsMedianMeanAndP95) {
   EXPECT_EQ(summarize({}).count, 0u);
 }
 
+TEST(RunStatistics, LatencySummaryIsMedianP99AndMax) {
+  std::vector<double> values;
+  for (int i = 200; i >= 1; --i) values.push_back(i);  // 1..200, unsorted
+  const LatencySummary l = summarize_latency(values);
+  EXPECT_EQ(l.count, 200u);
+  EXPECT_DOUBLE_EQ(l.median, 101.0);
+  EXPECT_DOUBLE_EQ(l.p99, 199.0);  // index floor(0.99 * 200) = 198
+  EXPECT_DOUBLE_EQ(l.max, 200.0);
+  const LatencySummary one = summarize_latency({33.0});
+  EXPECT_DOUBLE_EQ(one.p99, 33.0);
+  EXPECT_EQ(summarize_latency({}).count, 0u);
+}
+
 FrameReport frame(bool tracked, TrackingMethod method = TrackingMethod::kMotionModel) {
   FrameReport report;
   report.tracking.state = tracked ? TrackingState::kOk : TrackingState::kLost;

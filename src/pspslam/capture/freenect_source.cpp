@@ -30,6 +30,7 @@ struct RawFrame {
   Timestamp depth_time = 0.0;
   cv::Mat rgb;    // CV_8UC3, RGB order as the device sends it
   cv::Mat depth;  // CV_16UC1: millimetres (registered mode) or raw 11-bit disparity
+  std::chrono::steady_clock::time_point arrival;  // when the pair was complete
 };
 
 struct ContextDeleter {
@@ -183,7 +184,7 @@ class FreenectSource final : public FrameSource {
   void pair_if_complete() {
     if (pending_rgb_.empty() || pending_depth_.empty()) return;
     queue_.push({captured_++, pending_colour_time_, pending_depth_time_, std::move(pending_rgb_),
-                 std::move(pending_depth_)});
+                 std::move(pending_depth_), std::chrono::steady_clock::now()});
     pending_rgb_ = cv::Mat();
     pending_depth_ = cv::Mat();
   }
@@ -207,6 +208,7 @@ class FreenectSource final : public FrameSource {
     frame.index = raw.index;
     frame.timestamp = raw.colour_time;
     frame.depth_timestamp = raw.depth_time;
+    frame.arrival = raw.arrival;
     cv::cvtColor(raw.rgb, frame.bgr, cv::COLOR_RGB2BGR);
     cv::cvtColor(frame.bgr, frame.gray, cv::COLOR_BGR2GRAY);
     if (registered_) {

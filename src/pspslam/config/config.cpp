@@ -124,6 +124,7 @@ OrbConfig read_orb(YamlSection section) {
   orb.initial_fast_threshold =
       section.optional("initial_fast_threshold", orb.initial_fast_threshold);
   orb.min_fast_threshold = section.optional("min_fast_threshold", orb.min_fast_threshold);
+  orb.mask_compensation = section.optional("mask_compensation", orb.mask_compensation);
   require_positive(orb.n_features, section, "n_features");
   if (!(orb.scale_factor > 1.0)) {
     throw Error(section.file() + ": key '" + section.qualified("scale_factor") + "' must be > 1");
@@ -204,6 +205,9 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "n_levels" << YAML::Value << config.orb.n_levels;
   out << YAML::Key << "initial_fast_threshold" << YAML::Value << config.orb.initial_fast_threshold;
   out << YAML::Key << "min_fast_threshold" << YAML::Value << config.orb.min_fast_threshold;
+  // Written only when switched on, so that sequences rendered by this build still load in
+  // builds that predate the key (the accuracy panel runs both on the same sequences).
+  if (config.orb.mask_compensation) out << YAML::Key << "mask_compensation" << YAML::Value << true;
   out << YAML::EndMap;
   out << YAML::EndMap;
   std::ofstream stream(file);

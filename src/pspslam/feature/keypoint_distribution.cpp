@@ -143,4 +143,44 @@ void QuadtreeDistributor::distribute(std::span<const cv::KeyPoint> candidates,
   }
 }
 
+void share_feature_budget(std::span<const int> shares, std::span<const int> available,
+                          std::span<int> budgets) {
+  const std::size_t n = shares.size();
+  int spare = 0;
+  for (std::size_t l = 0; l < n; ++l) {
+    budgets[l] = std::min(shares[l], std::max(0, available[l]));
+    spare += shares[l] - budgets[l];
+  }
+  while (spare > 0) {
+    // Weights: the original shares (at least 1, so a level with a zero share can still absorb),
+    // of the levels that can take more.
+    long long weight = 0;
+    for (std::size_t l = 0; l < n; ++l) {
+      if (available[l] > budgets[l]) weight += std::max(1, shares[l]);
+    }
+    if (weight == 0) break;
+    int given = 0;
+    for (std::size_t l = 0; l < n; ++l) {
+      const int room = available[l] - budgets[l];
+      if (room <= 0) continue;
+      const auto proportional =
+          static_cast<int>(static_cast<long long>(spare) * std::max(1, shares[l]) / weight);
+      const int add = std::min(room, proportional);
+      budgets[l] += add;
+      given += add;
+    }
+    if (given == 0) {
+      // Every proportional part rounded to 0: hand out the remainder one by one, finest level
+      // first (it has the most candidates).
+      for (std::size_t l = 0; l < n && given < spare; ++l) {
+        if (available[l] > budgets[l]) {
+          ++budgets[l];
+          ++given;
+        }
+      }
+    }
+    spare -= given;
+  }
+}
+
 }  // namespace pspslam

@@ -45,4 +45,12 @@ class QuadtreeDistributor {
   std::vector<int> split_order_;
 };
 
+// Per-level feature budgets when some levels cannot fill their share: budgets[l] starts at
+// min(shares[l], available[l]), and what the short levels leave unused goes to the levels that
+// still have candidates to spare, in proportion to their shares (water-filling), so the total is
+// min(sum of shares, sum of available). A level never gets more than it has. All three spans have
+// the same length; deterministic, no allocation.
+void share_feature_budget(std::span<const int> shares, std::span<const int> available,
+                          std::span<int> budgets);
+
 }  // namespace pspslam

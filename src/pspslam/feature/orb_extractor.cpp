@@ -109,6 +109,9 @@ OrbExtractor::OrbExtractor(const OrbConfig& config, const BriefPattern& pattern)
   }
 
   pyramid_.resize(n_levels);
+  level_candidates_.resize(n_levels);
+  level_available_.resize(n_levels);
+  level_budget_ = features_per_level_;
 }
 
 void OrbExtractor::build_pyramid(const cv::Mat& gray) {
@@ -162,7 +165,8 @@ bool OrbExtractor::is_ignored(const cv::Mat& ignore_mask, float level_x, float l
 }
 
 void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
-  candidates_.clear();
+  std::vector<cv::KeyPoint>& candidates = level_candidates_[level];
+  candidates.clear();
   const cv::Mat& image = pyramid_[level].image;
   const int region_width = image.cols - 2 * kFastBorder;
   const int region_height = image.rows - 2 * kFastBorder;
@@ -184,7 +188,7 @@ void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
     const int col = (static_cast<int>(keypoint.pt.x) - kFastBorder) / cell_width;
     const int row = (static_cast<int>(keypoint.pt.y) - kFastBorder) / cell_height;
     ++cell_counts_[static_cast<std::size_t>(row) * n_cols + col];
-    candidates_.push_back(keypoint);
+    candidates.push_back(keypoint);
   }
   for (int row = 0; row < n_rows; ++row) {
     for (int col = 0; col < n_cols; ++col) {
@@ -212,9 +216,25 @@ void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
         keypoint.pt.x += static_cast<float>(window.x);
         keypoint.pt.y += static_cast<float>(window.y);
         if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, pyramid_[level])) continue;
-        candidates_.push_back(keypoint);
+        candidates.push_back(keypoint);
       }
     }
+  }
+}
+
+void OrbExtractor::detect_candidates_at_min_threshold(int level, const cv::Mat& ignore_mask) {
+  // One pass over the whole level: a FAST score is the highest threshold at which the point is a
+  // corner, so this finds every corner of the gridded pass (non-maximum suppression keeps them:
+  // a neighbour that outscores one was found before too) plus the weak ones of cells that had a
+  // strong corner somewhere. The quadtree still prefers the strongest corner of each node.
+  std::vector<cv::KeyPoint>& candidates = level_candidates_[level];
+  candidates.clear();
+  const cv::Mat& image = pyramid_[level].image;
+  if (image.cols <= 2 * kFastBorder || image.rows <= 2 * kFastBorder) return;
+  cv::FAST(image, fast_keypoints_, config_.min_fast_threshold, true);
+  for (const cv::KeyPoint& keypoint : fast_keypoints_) {
+    if (is_ignored(ignore_mask, keypoint.pt.x, keypoint.pt.y, pyramid_[level])) continue;
+    candidates.push_back(keypoint);
   }
 }
 
@@ -285,15 +305,33 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
 
   build_pyramid(gray);
 
+  for (int level = 0; level < levels(); ++level) detect_candidates(level, ignore_mask);
+  // Mask compensation (OrbConfig::mask_compensation, off by default): a mask over most of the
+  // image leaves the levels fewer corners than their shares (bonn_crowd_dev, people over
+  // 55-72 % of frames 310-326: 548-983 of 1000 kept, where the semantic-only error peaks). A
+  // short level is searched again at the minimum threshold, then what is still missing goes to
+  // the levels with corners to spare, so that the count stays near n_features. Measured there,
+  // it keeps the count but costs accuracy in every mode (docs/benchmarks.md, issue #18 item 3).
+  // Frames without masked pixels skip this and are extracted exactly as without compensation.
+  level_budget_ = features_per_level_;
+  if (config_.mask_compensation && !ignore_mask.empty() && cv::countNonZero(ignore_mask) > 0) {
+    for (int level = 0; level < levels(); ++level) {
+      if (static_cast<int>(level_candidates_[level].size()) < features_per_level_[level]) {
+        detect_candidates_at_min_threshold(level, ignore_mask);
+      }
+      level_available_[level] = static_cast<int>(level_candidates_[level].size());
+    }
+    share_feature_budget(features_per_level_, level_available_, level_budget_);
+  }
+
   // Pass 1: keypoints of every level, still in level coordinates (the descriptor needs them).
   out.keypoints.clear();
   for (int level = 0; level < levels(); ++level) {
-    detect_candidates(level, ignore_mask);
     const cv::Mat& image = pyramid_[level].image;
     const cv::Rect2f area(static_cast<float>(kFastBorder), static_cast<float>(kFastBorder),
                           static_cast<float>(image.cols - 2 * kFastBorder),
                           static_cast<float>(image.rows - 2 * kFastBorder));
-    distributor_.distribute(candidates_, area, features_per_level_[level], selected_);
+    distributor_.distribute(level_candidates_[level], area, level_budget_[level], selected_);
     const float size = kPatchSize * scale_factors_[level];
     for (cv::KeyPoint& keypoint : selected_) {
       keypoint.octave = level;

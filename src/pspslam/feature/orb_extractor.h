@@ -56,6 +56,9 @@ class OrbExtractor {
   // How many of config().n_features each level aims for: each level gets 1/scale_factor of the
   // previous level's share (217, 181, 151, ... for the defaults), summing to n_features.
   const std::vector<int>& features_per_level() const { return features_per_level_; }
+  // What each level was allowed in the last extract(): features_per_level(), or, in a frame whose
+  // mask left some levels short (OrbConfig::mask_compensation), their shortfall moved to others.
+  const std::vector<int>& level_budget() const { return level_budget_; }
   // Pyramid level l of the last extracted image (a view into the extractor's buffer, valid
   // until the next extract()).
   const cv::Mat& level_image(int level) const { return pyramid_[level].image; }
@@ -77,9 +80,12 @@ class OrbExtractor {
   };
 
   void build_pyramid(const cv::Mat& gray);
-  // FAST candidates of one level that are not masked; cells without any corner at the initial
-  // threshold are searched again with the minimum threshold.
+  // FAST candidates of one level that are not masked, into level_candidates_[level]; cells
+  // without any corner at the initial threshold are searched again with the minimum threshold.
   void detect_candidates(int level, const cv::Mat& ignore_mask);
+  // The whole level at the minimum threshold (unmasked corners only), replacing its candidates:
+  // for a level that the mask left short of its share (OrbConfig::mask_compensation).
+  void detect_candidates_at_min_threshold(int level, const cv::Mat& ignore_mask);
   bool is_ignored(const cv::Mat& ignore_mask, float level_x, float level_y,
                   const PyramidLevel& level) const;
   float orientation_degrees(const cv::Mat& image, const cv::Point2f& position) const;
@@ -106,7 +112,9 @@ class OrbExtractor {
 
   std::vector<PyramidLevel> pyramid_;
   std::vector<cv::KeyPoint> fast_keypoints_;
-  std::vector<cv::KeyPoint> candidates_;
+  std::vector<std::vector<cv::KeyPoint>> level_candidates_;  // per level, capacity reused
+  std::vector<int> level_available_;
+  std::vector<int> level_budget_;  // features_per_level_, or shared out by mask compensation
   std::vector<cv::KeyPoint> selected_;
   std::vector<int> cell_counts_;
   QuadtreeDistributor distributor_;

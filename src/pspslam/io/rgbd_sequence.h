@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <iostream>
@@ -54,6 +55,11 @@ struct RgbdFrame {
   // The colour image's file relative to its sequence ("rgb/1.5.png"); per-frame pictures are
   // named after it. A live camera frame is named as `pspslam record` would store it.
   std::string name;
+  // When the frame reached the run from the camera's point of view: a paced sequence's due time
+  // (`--realtime`), a live camera's pairing time on the driver thread. Empty for an unpaced
+  // sequence, where a frame has no arrival to measure from. The run measures the time from here
+  // to the frame's pose (stats.json `latency`).
+  std::optional<std::chrono::steady_clock::time_point> arrival;
 };
 
 // File names of one associated frame, relative to the sequence directory as listed.

@@ -25,8 +25,17 @@ std::optional<RgbdFrame> SequenceSource::next() {
     while (newest + 1 < frames_ && sequence.timestamp(newest + 1) - t0 <= elapsed) ++newest;
     dropped_ += newest - next_index_;
     next_index_ = newest;
-    const double wait = sequence.timestamp(newest) - t0 - elapsed;
+    const double due = sequence.timestamp(newest) - t0;
+    const double wait = due - elapsed;
     if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+    // The frame arrived when it was due, not when the busy caller came for it: the time it
+    // waited here is part of its latency, as it is for a camera's buffered frame.
+    std::optional<RgbdFrame> frame = sequence.load(next_index_++);
+    if (frame) {
+      frame->arrival = *start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     std::chrono::duration<double>(due));
+    }
+    return frame;
   }
   return sequence.load(next_index_++);
 }

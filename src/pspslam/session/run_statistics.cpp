@@ -26,6 +26,25 @@ nlohmann::ordered_json to_json(const TimingSummary& timing) {
           {"count", timing.count}};
 }
 
+LatencySummary summarize_latency(std::vector<double> values) {
+  LatencySummary summary;
+  summary.count = values.size();
+  if (values.empty()) return summary;
+  std::sort(values.begin(), values.end());
+  summary.median = values[values.size() / 2];
+  summary.p99 = values[std::min(values.size() - 1,
+                                static_cast<size_t>(0.99 * static_cast<double>(values.size())))];
+  summary.max = values.back();
+  return summary;
+}
+
+nlohmann::ordered_json to_json(const LatencySummary& latency) {
+  return {{"median", latency.median},
+          {"p99", latency.p99},
+          {"max", latency.max},
+          {"count", latency.count}};
+}
+
 void RunStatistics::add_frame(size_t index, const FrameReport& report, double local_ba_ms) {
   const TrackResult& result = report.tracking;
   if (result.method == TrackingMethod::kRelocalisation) ++relocalisations_;

@@ -23,6 +23,17 @@ struct TimingSummary {
 TimingSummary summarize(std::vector<double> values);
 nlohmann::ordered_json to_json(const TimingSummary& timing);
 
+// The real-time figures of issue #18: median, p99 and max of a per-frame series (nearest-rank on
+// the sorted values, the same rule as TimingSummary's p95).
+struct LatencySummary {
+  double median = 0.0;
+  double p99 = 0.0;
+  double max = 0.0;
+  size_t count = 0;
+};
+LatencySummary summarize_latency(std::vector<double> values);
+nlohmann::ordered_json to_json(const LatencySummary& latency);
+
 // Accumulates what each frame of a run reports: per-module times, dynamic-feature totals, lost
 // frames, relocalisations and (with a blackout) when poses came back. Read by run_report.h.
 class RunStatistics {
@@ -58,6 +69,9 @@ class RunStatistics {
   // sleeps, which costs no CPU): what watching costs the frames, apart from the detail recorded
   // inside System::process for the shown frames.
   std::vector<double> observer_cpu_ms;
+  // Frames with an arrival time (RgbdFrame::arrival: --realtime, cameras): from arrival to the
+  // end of System::process(), i.e. until the pose (or the verdict that there is none) exists.
+  std::vector<double> arrival_to_pose_ms;
   size_t tested_points = 0;
   size_t dynamic_points = 0;
   size_t masked_keypoints = 0;

@@ -165,6 +165,12 @@ RunOutcome SequenceRunner::run() {
                                          overlays || detail.masked_keypoints);
     }
     const FrameReport report = system_->process(frame);
+    if (frame.arrival) {
+      statistics_.arrival_to_pose_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                    *frame.arrival)
+              .count());
+    }
     const TrackResult& result = report.tracking;
     spdlog::debug(
         "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "

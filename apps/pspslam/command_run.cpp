@@ -269,8 +269,8 @@ Command add_run_command(CLI::App& root) {
   app->add_option("--sensor", flags->sensor,
                   "rgbd | stereo: overrides the config's camera.type (monocular: not yet)");
   app->add_option("--trajectory-format", flags->trajectory_format,
-                  "tum, or kitti: also write OUT/trajectory_refined_kitti.txt (3x4 row-major "
-                  "camera-to-world per tracked frame)")
+                  "tum, or kitti: also write OUT/trajectory_kitti.txt and "
+                  "trajectory_refined_kitti.txt (3x4 row-major camera-to-world per tracked frame)")
       ->check(CLI::IsMember({"tum", "kitti"}))
       ->capture_default_str();
   app->add_option("--out", flags->out, "output folder")->capture_default_str();

@@ -110,6 +110,17 @@ TEST(Stereo, TumKittiAndEurocLayoutsGiveTheSameTrajectory) {
     EXPECT_TRUE(tum[i].T_world_camera.isApprox(kitti[i].T_world_camera, 1e-9)) << "frame " << i;
   }
   EXPECT_EQ(count_lines(dir / "out_kitti" / "trajectory_refined_kitti.txt"), 40);
+  // The online file in KITTI format holds the same poses as trajectory.txt, row by row.
+  const Trajectory online = read_tum_trajectory(dir / "out_kitti" / "trajectory.txt");
+  std::vector<Timestamp> stamps;
+  for (const StampedPose& pose : online) stamps.push_back(pose.timestamp);
+  const Trajectory online_kitti =
+      read_kitti_trajectory(dir / "out_kitti" / "trajectory_kitti.txt", stamps);
+  ASSERT_EQ(online_kitti.size(), online.size());
+  for (size_t i = 0; i < online.size(); ++i) {
+    EXPECT_TRUE(online_kitti[i].T_world_camera.isApprox(online[i].T_world_camera, 1e-6))
+        << "frame " << i;
+  }
   // EuRoC: the stamps are whole nanoseconds and the pair goes through cv::stereoRectify + remap
   // (the identity here, up to interpolation): the same ATE, not the same bytes.
   const Trajectory euroc = read_tum_trajectory(dir / "out_euroc" / "trajectory_refined.txt");

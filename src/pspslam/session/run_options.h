@@ -26,8 +26,9 @@ struct RunOutputs {
   // image: the final dynamic mask (8-bit PNG, 255 = dynamic) and the keypoint overlay.
   std::filesystem::path masks;
   std::filesystem::path overlays;
-  // `--trajectory-format kitti`: also write trajectory_refined_kitti.txt (KITTI odometry format,
-  // 3x4 row-major camera-to-world per tracked frame, in frame order).
+  // `--trajectory-format kitti`: also write trajectory_kitti.txt (online, the file to evaluate)
+  // and trajectory_refined_kitti.txt in KITTI odometry format (3x4 row-major camera-to-world per
+  // tracked frame, in frame order).
   bool kitti_trajectory = false;
 };
 

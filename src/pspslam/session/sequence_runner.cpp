@@ -241,8 +241,10 @@ void SequenceRunner::finish(double seconds) {
   write_tum_trajectory(out_dir / "keyframes.txt", system_->keyframe_trajectory());
   const Trajectory refined = system_->refined_trajectory();
   write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
-  if (options_.outputs.kitti_trajectory)
+  if (options_.outputs.kitti_trajectory) {
+    write_kitti_trajectory(out_dir / "trajectory_kitti.txt", estimate_);
     write_kitti_trajectory(out_dir / "trajectory_refined_kitti.txt", refined);
+  }
   const MappingStats mapping = system_->mapping_stats();
   if (exporter_) write_map_exports(options_.outputs, *exporter_, system_->map(), out_);
   write_run_report({.options = options_,

@@ -5,7 +5,7 @@ inside a pair alternates). Per run: fps and frames processed (stats.json) and th
 time per processed frame (user + system of the pspslam process alone, from wait4: on a shared,
 loaded machine fps mostly measures the other processes, CPU time much less). Prints each run and
 the medians. Usage: bench/viewer_overhead.py [BUILD_DIR] [--pairs N] [--dynamic MODE]
-[--no-browser]
+[--no-browser] [--interval MS]
 """
 import argparse
 import json
@@ -41,12 +41,14 @@ class Run:
         return self.status is not None
 
 
-def run_once(cli, sequence, mode, out, viewer, attach_browser=True):
+def run_once(cli, sequence, mode, out, viewer, attach_browser=True, interval_ms=None):
     command = [str(cli), "run", "--sequence", str(sequence), "--config",
                str(root / "config/bonn.yaml"), "--dynamic", mode, "--realtime", "--quiet",
                "--out", str(out)]
     if viewer:
         command += ["--viewer", "127.0.0.1:0"]
+        if interval_ms is not None:
+            command += ["--viewer-interval", str(interval_ms)]
     browser = None
     profile = None
     pages = 0
@@ -101,6 +103,8 @@ def main():
     parser.add_argument("--dynamic", default="full")
     parser.add_argument("--no-browser", action="store_true",
                         help="the viewer without a page attached (the server's own cost)")
+    parser.add_argument("--interval", type=int, default=None,
+                        help="--viewer-interval MS of the viewed runs (default: the run's own)")
     args = parser.parse_args()
     cli = Path(args.build) / "apps/pspslam"
     sequence = shared / "data/bonn_crowd_dev"
@@ -111,7 +115,8 @@ def main():
     for pair in range(args.pairs):
         for viewer in ([False, True] if pair % 2 == 0 else [True, False]):
             out = work / f"pair{pair}_{'viewer' if viewer else 'plain'}"
-            r = run_once(cli, sequence, args.dynamic, out, viewer, not args.no_browser)
+            r = run_once(cli, sequence, args.dynamic, out, viewer, not args.no_browser,
+                         args.interval)
             results[viewer].append(r)
             print(f"pair {pair} {with_name if viewer else 'plain':15s}: {r['fps']:.2f} fps, "
                   f"{r['frames']} frames processed, {r['dropped']} dropped by the feed, "

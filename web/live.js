@@ -158,6 +158,7 @@ function setCurrentCamera(pose) {
   }
   currentPosition = position;
   view.controls.update();
+  body.dataset.orbitTarget = view.controls.target.toArray().map((v) => v.toFixed(4)).join(' ');
   requestRender();
 }
 

@@ -48,9 +48,78 @@ try {
   seen.paused_later = Number((await data(page)).frame);
   await page.screenshot({ path: screenshot });
 
+  // The toggles, on the held frame: each changes what is drawn, and only its own part.
+  // Frame view: pixels drawn on the marks canvas, and the label overlay's display.
+  const marks = () => page.evaluate(() => {
+    const canvas = document.getElementById('marks');
+    const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    let drawn = 0;
+    for (let i = 3; i < pixels.length; i += 4) drawn += pixels[i] > 0;
+    return drawn;
+  });
+  const display = (id) => page.evaluate((id) => getComputedStyle(document.getElementById(id)).display, id);
+  // 3D view: pixels of the covisibility edges' green (0x3a9d54) in the WebGL canvas.
+  const covisPixels = () => page.evaluate(() => {
+    const gl = document.querySelector('#scene canvas');
+    const copy = document.createElement('canvas');
+    copy.width = gl.width;
+    copy.height = gl.height;
+    const g = copy.getContext('2d');
+    g.drawImage(gl, 0, 0);
+    const pixels = g.getImageData(0, 0, copy.width, copy.height).data;
+    let green = 0;
+    for (let i = 0; i < pixels.length; i += 4) {
+      green += Math.abs(pixels[i] - 0x3a) < 24 && Math.abs(pixels[i + 1] - 0x9d) < 24 &&
+               Math.abs(pixels[i + 2] - 0x54) < 24;
+    }
+    return green;
+  });
+  const settle = () => sleep(400);  // a change is drawn on the next animation frame
+  seen.marks_on = await marks();
+  await page.click('#show-keypoints');
+  await settle();
+  seen.marks_keypoints_off = await marks();
+  await page.click('#show-search');
+  await settle();
+  seen.marks_search_only = await marks();
+  await page.click('#show-keypoints');
+  await page.click('#show-search');
+  await settle();
+  seen.marks_back = await marks();
+  seen.labels_shown = await display('labels');
+  await page.click('#show-labels');
+  await settle();
+  seen.labels_hidden = await display('labels');
+  await page.click('#show-labels');
+  seen.covis_on = await covisPixels();
+  await page.click('#show-covis');
+  await settle();
+  seen.covis_off = await covisPixels();
+  await page.click('#show-covis');
+  await settle();
+  seen.covis_back = await covisPixels();
+  // Follow camera: off, a step leaves the orbit target where it is; on, a step moves it.
+  const stepOnce = async () => {
+    const before = Number((await data(page)).frame);
+    await page.click('#step');
+    await page.waitForFunction(`${held} && Number(document.body.dataset.frame) > ${before}`,
+                               null, { timeout: 60000 });
+    await settle();
+  };
+  const target = async () => (await data(page)).orbitTarget;
+  const unfollowed = await target();
+  await stepOnce();
+  seen.target_kept_without_follow = (await target()) === unfollowed;
+  await page.click('#follow');
+  const followed = await target();
+  await stepOnce();
+  seen.target_moved_with_follow = (await target()) !== followed;
+  seen.held_after_toggles = Number((await data(page)).frame);
+
   await page.click('#step');
-  await page.waitForFunction(`${held} && Number(document.body.dataset.frame) > ${seen.paused}`,
-                             null, { timeout: 60000 });
+  await page.waitForFunction(
+      `${held} && Number(document.body.dataset.frame) > ${seen.held_after_toggles}`, null,
+      { timeout: 60000 });
   seen.paused_step = Number((await data(page)).frame);
   await page.click('#resume');
   await page.waitForFunction(`document.body.dataset.runState === 'finished'`, null,

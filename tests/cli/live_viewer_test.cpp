@@ -138,9 +138,24 @@ TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
   EXPECT_GT(seen["map_points"].get<int>(), 100);
   EXPECT_GE(seen["keyframes"].get<int>(), 2);
   EXPECT_GT(seen["dynamic_seen"].get<int>(), 0);
+  // The toggles (on held frames): keypoints off leaves the canvas empty (the ant path is off by
+  // default), the ant path alone draws something, both back give the same picture; the label
+  // overlay hides and the covisibility edges disappear from the 3D view and come back.
+  EXPECT_GT(seen["marks_on"].get<int>(), 100);
+  EXPECT_EQ(seen["marks_keypoints_off"], 0);
+  EXPECT_GT(seen["marks_search_only"].get<int>(), 0);
+  EXPECT_EQ(seen["marks_back"], seen["marks_on"]);
+  EXPECT_EQ(seen["labels_shown"], "block");
+  EXPECT_EQ(seen["labels_hidden"], "none");
+  EXPECT_GT(seen["covis_on"].get<int>(), 0);
+  EXPECT_EQ(seen["covis_off"], 0);
+  EXPECT_EQ(seen["covis_back"], seen["covis_on"]);
+  // Follow camera: the orbit target stays without it and moves with the camera with it.
+  EXPECT_TRUE(seen.value("target_kept_without_follow", false));
+  EXPECT_TRUE(seen.value("target_moved_with_follow", false));
+  EXPECT_EQ(seen["held_after_toggles"].get<int>(), seen["paused"].get<int>() + 2);  // two steps
   // Pause stops the frame counter; step moves it by one.
-  EXPECT_EQ(seen["paused_later"], seen["paused"]);
-  EXPECT_EQ(seen["paused_step"].get<int>(), seen["paused"].get<int>() + 1);
+  EXPECT_EQ(seen["paused_step"].get<int>(), seen["held_after_toggles"].get<int>() + 1);
   EXPECT_LT(seen["paused"].get<int>(), kFrames - 1);
   EXPECT_TRUE(seen.value("finished", false));
 

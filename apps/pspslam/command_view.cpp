@@ -85,9 +85,8 @@ nlohmann::json ground_truth_json(const fs::path& gt_file, const Trajectory& esti
   nlohmann::json result = {{"file", gt_file.string()}, {"positions", nlohmann::json::array()}};
   if (gt_file.empty() || estimate.empty()) return result;
   const AteResult ate = compute_ate(read_tum_trajectory(gt_file), estimate);
-  const Alignment& a = ate.alignment;
   for (const Eigen::Vector3d& g : ate.gt_all) {
-    const Eigen::Vector3d p = a.rotation.transpose() * (g - a.translation) / a.scale;
+    const Eigen::Vector3d p = ate.alignment.inverse_apply(g);
     result["positions"].push_back({p.x(), p.y(), p.z()});
   }
   result["ate_rmse"] = ate.error.rmse;

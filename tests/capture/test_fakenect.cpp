@@ -36,9 +36,7 @@ Result replayed(const std::filesystem::path& dump, const std::string& arguments)
   return shell(testing::fakenect_environment(dump) + PSPSLAM_CLI_PATH + " " + arguments);
 }
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::contains;
 
 nlohmann::json read_json(const std::filesystem::path& file) {
   std::ifstream stream(file);

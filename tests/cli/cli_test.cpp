@@ -37,14 +37,8 @@ Result pspslam_in(const std::filesystem::path& folder, const std::string& argume
   return result;
 }
 
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::contains;
+using testing::read_text;
 
 size_t count_of(const std::string& text, const std::string& part) {
   size_t count = 0;

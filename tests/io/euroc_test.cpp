@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_text(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+using testing::write_text;
 
 constexpr int kWidth = 200;
 constexpr int kHeight = 150;

@@ -12,9 +12,7 @@
 namespace pspslam {
 namespace {
 
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream(file) << text;
-}
+using testing::write_text;
 
 // A small TUM-layout sequence: 4 colour frames at 0.1 s, depth 5 ms later, depth value 5000*k.
 std::filesystem::path make_sequence(const std::string& tag) {

@@ -15,7 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_text(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+using testing::write_text;
 
 constexpr const char* kCalibration =
     "P0: 500 0 320 0 0 510 240 0 0 0 1 0\n"

@@ -19,6 +19,14 @@ std::filesystem::path make_temp_dir(const std::string& tag);
 // Runs a shell command, returns its exit status; stdout+stderr land in *output.
 int run_shell(const std::string& command, std::string* output);
 
+// A whole text file ("" when it cannot be read), and a file written with `text`.
+std::string read_text(const std::filesystem::path& file);
+void write_text(const std::filesystem::path& file, const std::string& text);
+
+inline bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
 }  // namespace pspslam::testing
 
 // Use at the top of a test that reads ../shared:

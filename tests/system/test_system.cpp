@@ -229,12 +229,7 @@ TEST(RunCommand, TracksTheStaticStretchOfBonnCrowd) {
   EXPECT_LT(ate.error.rmse, 0.05) << output;
 }
 
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using testing::read_text;
 
 // Ctrl-C in the middle of `pspslam run`: the loop stops, the run still ends cleanly with status
 // 130, a parsable trajectory and a complete stats.json. The default mode (full: semantic thread

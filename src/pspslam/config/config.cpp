@@ -71,16 +71,16 @@ CameraConfig read_camera(YamlSection section) {
   }
   for (size_t i = 0; i < distortion.size(); ++i) p.distortion[i] = distortion[i];
   camera.fps = section.required<double>("fps");
+  require_positive(p.width, section, "width");
+  require_positive(p.height, section, "height");
   require_positive(p.fx, section, "fx");
+  require_positive(p.fy, section, "fy");
+  require_positive(camera.fps, section, "fps");
   if (camera.type == SensorType::stereo) {
     refuse_depth_image_keys(section);
     read_stereo_baseline(section, camera);
     camera.depth_threshold = section.optional("depth_threshold", 40.0 * camera.baseline);
     require_positive(camera.depth_threshold, section, "depth_threshold");
-    require_positive(p.width, section, "width");
-    require_positive(p.height, section, "height");
-    require_positive(p.fy, section, "fy");
-    require_positive(camera.fps, section, "fps");
     section.finish();
     return camera;
   }
@@ -104,11 +104,6 @@ CameraConfig read_camera(YamlSection section) {
   }
   camera.depth_shift_x = shift[0];
   camera.depth_shift_y = shift[1];
-  require_positive(p.width, section, "width");
-  require_positive(p.height, section, "height");
-  require_positive(p.fx, section, "fx");
-  require_positive(p.fy, section, "fy");
-  require_positive(camera.fps, section, "fps");
   require_positive(camera.depth_factor, section, "depth_factor");
   require_positive(camera.depth_threshold, section, "depth_threshold");
   require_positive(camera.depth_noise_scale, section, "depth_noise_scale");

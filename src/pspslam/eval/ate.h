@@ -28,6 +28,11 @@ struct Alignment {
   Eigen::Vector3d apply(const Eigen::Vector3d& point) const {
     return scale * (rotation * point) + translation;
   }
+  // The inverse map: a ground-truth position into the estimate's frame (the viewers draw the
+  // ground truth there, so the map and the estimate keep their own coordinates).
+  Eigen::Vector3d inverse_apply(const Eigen::Vector3d& point) const {
+    return rotation.transpose() * (point - translation) / scale;
+  }
 };
 
 // Closed-form least-squares alignment of `model` onto `data` (3xN, columns paired), exactly as

@@ -21,6 +21,21 @@ void apply_sensor_override(SystemConfig& config, SensorType sensor,
 
 namespace {
 
+// The camera of a rectified stereo layout, from its calibration: pinhole of the rectified left
+// image, no distortion (the frames are rectified, by the dataset or as they load), the baseline.
+void set_rectified_stereo_camera(CameraConfig& camera, cv::Size size, double fx, double fy,
+                                 double cx, double cy, double baseline) {
+  camera.type = SensorType::stereo;
+  camera.pinhole.width = size.width;
+  camera.pinhole.height = size.height;
+  camera.pinhole.fx = fx;
+  camera.pinhole.fy = fy;
+  camera.pinhole.cx = cx;
+  camera.pinhole.cy = cy;
+  camera.pinhole.distortion = {};
+  camera.baseline = baseline;
+}
+
 SequenceSetup open_kitti_with_config(const std::filesystem::path& dir,
                                      const std::optional<std::filesystem::path>& config_file,
                                      std::ostream* warnings) {
@@ -37,15 +52,8 @@ SequenceSetup open_kitti_with_config(const std::filesystem::path& dir,
   const RgbdFrame first = sequence.load(0);
   CameraConfig& camera = config.camera;
   if (!config_file) camera.name = "kitti";
-  camera.type = SensorType::stereo;
-  camera.pinhole.width = first.bgr.cols;
-  camera.pinhole.height = first.bgr.rows;
-  camera.pinhole.fx = calibration.fx;
-  camera.pinhole.fy = calibration.fy;
-  camera.pinhole.cx = calibration.cx;
-  camera.pinhole.cy = calibration.cy;
-  camera.pinhole.distortion = {};  // KITTI images are rectified
-  camera.baseline = calibration.baseline;
+  set_rectified_stereo_camera(camera, first.bgr.size(), calibration.fx, calibration.fy,
+                              calibration.cx, calibration.cy, calibration.baseline);
   if (!config_file || camera.depth_threshold <= 0.0)
     camera.depth_threshold = 40.0 * camera.baseline;
   if (!config_file && sequence.size() > 1) {
@@ -71,15 +79,7 @@ SequenceSetup open_euroc_with_config(const std::filesystem::path& dir,
   const EurocCamera left = read_euroc_camera(sequence.directory() / "cam0" / "sensor.yaml");
   CameraConfig& camera = config.camera;
   if (!config_file) camera.name = "euroc";
-  camera.type = SensorType::stereo;
-  camera.pinhole.width = rect.size.width;
-  camera.pinhole.height = rect.size.height;
-  camera.pinhole.fx = rect.fx;
-  camera.pinhole.fy = rect.fy;
-  camera.pinhole.cx = rect.cx;
-  camera.pinhole.cy = rect.cy;
-  camera.pinhole.distortion = {};  // the frames are rectified as they load
-  camera.baseline = rect.baseline;
+  set_rectified_stereo_camera(camera, rect.size, rect.fx, rect.fy, rect.cx, rect.cy, rect.baseline);
   if (!config_file) {
     camera.depth_threshold = 40.0 * camera.baseline;
     camera.fps = left.rate_hz;

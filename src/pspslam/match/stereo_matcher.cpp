@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 #include "pspslam/feature/hamming.h"
 
@@ -54,13 +55,26 @@ void match_stereo(const std::vector<cv::KeyPoint>& left, const cv::Mat& left_des
   const int cols = right_gray.cols;
 
   // Right keypoints by the rows their band covers: the lookup per left keypoint is one row.
-  std::vector<std::vector<int>> by_row(static_cast<size_t>(rows));
+  // Two flat arrays (row y's keypoints are row_keypoints[row_start[y], row_start[y + 1]), in
+  // ascending index) rather than a vector per row: no allocation per keypoint.
+  const auto band_rows = [&](const cv::KeyPoint& keypoint) {
+    const float band = 2.0f * static_cast<float>(pyramid.scale[keypoint.octave]);
+    return std::pair{std::max(0, static_cast<int>(std::floor(keypoint.pt.y - band))),
+                     std::min(rows - 1, static_cast<int>(std::ceil(keypoint.pt.y + band)))};
+  };
+  std::vector<int> row_start(static_cast<size_t>(rows) + 1, 0);
+  for (const cv::KeyPoint& keypoint : right) {
+    const auto [first, last] = band_rows(keypoint);
+    for (int y = first; y <= last; ++y) ++row_start[static_cast<size_t>(y) + 1];
+  }
+  for (int y = 0; y < rows; ++y)
+    row_start[static_cast<size_t>(y) + 1] += row_start[static_cast<size_t>(y)];
+  std::vector<int> row_keypoints(static_cast<size_t>(row_start.back()));
+  std::vector<int> row_fill(row_start.begin(), row_start.end() - 1);
   for (size_t j = 0; j < right.size(); ++j) {
-    const float band = 2.0f * static_cast<float>(pyramid.scale[right[j].octave]);
-    const int first = std::max(0, static_cast<int>(std::floor(right[j].pt.y - band)));
-    const int last = std::min(rows - 1, static_cast<int>(std::ceil(right[j].pt.y + band)));
+    const auto [first, last] = band_rows(right[j]);
     for (int y = first; y <= last; ++y)
-      by_row[static_cast<size_t>(y)].push_back(static_cast<int>(j));
+      row_keypoints[static_cast<size_t>(row_fill[static_cast<size_t>(y)]++)] = static_cast<int>(j);
   }
 
   const float max_disparity = static_cast<float>(bf / options.min_depth_m);
@@ -76,7 +90,9 @@ void match_stereo(const std::vector<cv::KeyPoint>& left, const cv::Mat& left_des
     int best_distance = options.max_descriptor_distance + 1;
     int best = -1;
     const std::uint8_t* descriptor = left_descriptors.ptr<std::uint8_t>(static_cast<int>(i));
-    for (const int j : by_row[static_cast<size_t>(row)]) {
+    for (int r = row_start[static_cast<size_t>(row)]; r < row_start[static_cast<size_t>(row) + 1];
+         ++r) {
+      const int j = row_keypoints[static_cast<size_t>(r)];
       const cv::KeyPoint& kr = right[static_cast<size_t>(j)];
       if (std::abs(kr.octave - kl.octave) > 1) continue;
       const float disparity = ul - kr.pt.x;

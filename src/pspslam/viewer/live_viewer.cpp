@@ -484,9 +484,8 @@ void LiveViewer::publish_map(const MapSnapshot& s) {
   if (!ground_truth_.empty() && s.estimate.size() >= 10) {
     try {
       const AteResult ate = compute_ate(ground_truth_, s.estimate);
-      const Alignment& a = ate.alignment;
       for (const Eigen::Vector3d& g : ate.gt_all) {
-        const Eigen::Vector3d p = a.rotation.transpose() * (g - a.translation) / a.scale;
+        const Eigen::Vector3d p = ate.alignment.inverse_apply(g);
         truth.push_back({p.x(), p.y(), p.z()});
       }
       ate_rmse = ate.error.rmse;

@@ -267,7 +267,8 @@ Command add_run_command(CLI::App& root) {
                   "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
                   "else required; presets in config/)");
   app->add_option("--sensor", flags->sensor,
-                  "rgbd | stereo: overrides the config's camera.type (monocular: not yet)");
+                  "rgbd | stereo | monocular: overrides the config's camera.type (monocular reads "
+                  "the colour images of any RGB-D folder and ignores depth)");
   app->add_option("--trajectory-format", flags->trajectory_format,
                   "tum, or kitti: also write OUT/trajectory_kitti.txt and "
                   "trajectory_refined_kitti.txt (3x4 row-major camera-to-world per tracked frame)")

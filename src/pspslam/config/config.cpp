@@ -18,14 +18,14 @@ void require_positive(double value, const YamlSection& section, const std::strin
   }
 }
 
-// The keys that describe a depth image make no sense for a stereo pair: name them rather than
-// call them unknown (they are valid keys, for another sensor).
-void refuse_depth_image_keys(const YamlSection& section) {
+// The keys that describe a depth image make no sense for a stereo pair or a single colour
+// camera: name them rather than call them unknown (they are valid keys, for another sensor).
+void refuse_depth_image_keys(const YamlSection& section, SensorType type) {
   for (const char* key :
        {"depth_factor", "depth_noise", "depth_noise_scale", "depth_registration_shift_px"}) {
     if (section.contains(key)) {
       throw Error(section.where(key) + "key '" + section.qualified(key) +
-                  "' is for rgbd cameras only (camera.type is stereo)");
+                  "' is for rgbd cameras only (camera.type is " + to_string(type) + ")");
     }
   }
 }
@@ -76,8 +76,20 @@ CameraConfig read_camera(YamlSection section) {
   require_positive(p.fx, section, "fx");
   require_positive(p.fy, section, "fy");
   require_positive(camera.fps, section, "fps");
+  if (camera.type == SensorType::monocular) {
+    // No depth at all: nothing is "close" or "far" (depth_threshold is not read).
+    refuse_depth_image_keys(section, camera.type);
+    for (const char* key : {"baseline", "bf", "depth_threshold"}) {
+      if (section.contains(key)) {
+        throw Error(section.where(key) + "key '" + section.qualified(key) +
+                    "' has no meaning for a monocular camera (camera.type is monocular)");
+      }
+    }
+    section.finish();
+    return camera;
+  }
   if (camera.type == SensorType::stereo) {
-    refuse_depth_image_keys(section);
+    refuse_depth_image_keys(section, camera.type);
     read_stereo_baseline(section, camera);
     camera.depth_threshold = section.optional("depth_threshold", 40.0 * camera.baseline);
     require_positive(camera.depth_threshold, section, "depth_threshold");
@@ -134,13 +146,21 @@ OrbConfig read_orb(YamlSection section) {
 SensorType parse_sensor_type(const std::string& name, const std::string& where) {
   if (name == "rgbd") return SensorType::rgbd;
   if (name == "stereo") return SensorType::stereo;
-  if (name == "monocular") {
-    throw Error(where + ": monocular is not supported yet (issue #16); use rgbd or stereo");
-  }
-  throw Error(where + ": must be rgbd or stereo, got '" + name + "'");
+  if (name == "monocular") return SensorType::monocular;
+  throw Error(where + ": must be rgbd, stereo or monocular, got '" + name + "'");
 }
 
-std::string to_string(SensorType type) { return type == SensorType::stereo ? "stereo" : "rgbd"; }
+std::string to_string(SensorType type) {
+  switch (type) {
+    case SensorType::stereo:
+      return "stereo";
+    case SensorType::monocular:
+      return "monocular";
+    case SensorType::rgbd:
+      break;
+  }
+  return "rgbd";
+}
 
 SystemConfig load_config(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw Error(file.string() + ": config file not found");
@@ -167,7 +187,9 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   const PinholeCamera& p = config.camera.pinhole;
   out << YAML::Key << "name" << YAML::Value << config.camera.name;
   const bool stereo = config.camera.type == SensorType::stereo;
-  if (stereo) out << YAML::Key << "type" << YAML::Value << "stereo";
+  const bool monocular = config.camera.type == SensorType::monocular;
+  if (config.camera.type != SensorType::rgbd)
+    out << YAML::Key << "type" << YAML::Value << to_string(config.camera.type);
   out << YAML::Key << "width" << YAML::Value << p.width;
   out << YAML::Key << "height" << YAML::Value << p.height;
   out << YAML::Key << "fx" << YAML::Value << p.fx;
@@ -181,15 +203,16 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
     out << YAML::Key << "baseline" << YAML::Value << config.camera.baseline;
     out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
   }
-  if (!stereo) out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
-  if (!stereo) {
+  if (!stereo && !monocular) {
+    out << YAML::Key << "depth_factor" << YAML::Value << config.camera.depth_factor;
     out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;
     out << YAML::Key << "depth_noise" << YAML::Value
         << (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1 ? "kinect_v1"
                                                                              : "none");
     out << YAML::Key << "depth_noise_scale" << YAML::Value << config.camera.depth_noise_scale;
   }
-  if (!stereo && (config.camera.depth_shift_x != 0 || config.camera.depth_shift_y != 0)) {
+  if (!stereo && !monocular &&
+      (config.camera.depth_shift_x != 0 || config.camera.depth_shift_y != 0)) {
     out << YAML::Key << "depth_registration_shift_px" << YAML::Value << YAML::Flow
         << std::vector<int>{config.camera.depth_shift_x, config.camera.depth_shift_y};
   }

@@ -9,8 +9,8 @@ namespace pspslam {
 
 // What the camera delivers (key `camera.type`, default rgbd). Every difference between the
 // sensors past the config lives in one place, the per-sensor frame builder
-// (tracking/frame_builder.h). Monocular (issue #16) is rejected as not yet supported.
-enum class SensorType { rgbd, stereo };
+// (system/frame_builder.h).
+enum class SensorType { rgbd, stereo, monocular };
 SensorType parse_sensor_type(const std::string& name, const std::string& where);
 std::string to_string(SensorType type);
 
@@ -18,7 +18,7 @@ std::string to_string(SensorType type);
 // rgbd needs depth_factor and depth_threshold; stereo needs exactly one of `baseline` (metres)
 // and `bf` (fx * baseline, pixel metres) and refuses the depth-image keys; its depth_threshold is
 // optional (default 40 baselines: farther stereo depth is too coarse to make a point from one
-// view, ORB-SLAM2's rule).
+// view, ORB-SLAM2's rule). monocular needs neither and refuses both (colour images only).
 struct CameraConfig {
   std::string name = "unnamed";
   SensorType type = SensorType::rgbd;

@@ -136,7 +136,13 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
   std::vector<FrameFiles> associated;
   std::vector<std::string> listed_files;  // every listed file, in listing order
   const std::filesystem::path associations = dir / "associations.txt";
-  if (!options.stereo && std::filesystem::exists(associations)) {
+  if (options.colour_only && std::filesystem::exists(dir / "rgb.txt")) {
+    for (const ListedFile& f : read_file_list(dir / "rgb.txt")) {
+      associated.push_back({f.timestamp, f.file, f.timestamp, std::string()});
+      listed_files.push_back(f.file);
+    }
+    sequence.listed_rgb_ = associated.size();
+  } else if (!options.stereo && std::filesystem::exists(associations)) {
     associated = read_associations(associations);
     sequence.used_associations_file_ = true;
     sequence.listed_rgb_ = sequence.listed_depth_ = associated.size();
@@ -180,6 +186,10 @@ RgbdSequence RgbdSequence::open(const std::filesystem::path& dir, const Sequence
 
   sequence.keep_present_frames(std::move(associated), listed_files);
   if (sequence.frames_.empty()) {
+    if (options.colour_only) {
+      throw Error(dir.string() + ": no colour frame: " + std::to_string(sequence.listed_rgb_) +
+                  " colour files listed, none present");
+    }
     throw Error(dir.string() + ": no " + (options.stereo ? "stereo" : "RGB-D") +
                 " frame: " + std::to_string(sequence.listed_rgb_) + " colour and " +
                 std::to_string(sequence.listed_depth_) + (options.stereo ? " right" : " depth") +
@@ -466,6 +476,10 @@ RgbdFrame RgbdSequence::load(size_t i) const {
       frame.bgr = left;
       frame.right = right;
     }
+    if (options_.load_gray) cv::cvtColor(frame.bgr, frame.gray, cv::COLOR_BGR2GRAY);
+    return frame;
+  }
+  if (options_.colour_only) {
     if (options_.load_gray) cv::cvtColor(frame.bgr, frame.gray, cv::COLOR_BGR2GRAY);
     return frame;
   }

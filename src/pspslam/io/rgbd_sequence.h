@@ -33,6 +33,9 @@ struct SequenceOptions {
   // A rectified stereo pair per frame instead of colour + depth: the TUM-style lists are
   // rgb.txt (left) and right.txt (right, CV_8UC1 in RgbdFrame::right); no depth is read.
   bool stereo = false;
+  // Colour images only (a monocular run on an RGB-D folder): rgb.txt alone is read, every listed
+  // colour image is a frame, and no depth is listed, associated or loaded.
+  bool colour_only = false;
 };
 
 // How a sequence folder is laid out (detected by open_sequence_with_config).

@@ -10,13 +10,18 @@ namespace pspslam {
 void apply_sensor_override(SystemConfig& config, SensorType sensor,
                            const std::filesystem::path& config_file) {
   if (config.camera.type == sensor) return;
+  if (sensor == SensorType::monocular) {
+    // Any camera has a colour (left) image: an RGB-D config's depth keys are simply not used.
+    config.camera.type = SensorType::monocular;
+    return;
+  }
   if (sensor == SensorType::stereo) {
     throw Error("--sensor stereo: " + config_file.string() +
                 " describes an rgbd camera and gives no camera.baseline (use a stereo config, "
                 "e.g. the one `pspslam synth --stereo` writes)");
   }
-  throw Error("--sensor rgbd: " + config_file.string() +
-              " describes a stereo camera (no depth_factor); a stereo pair has no depth image");
+  throw Error("--sensor rgbd: " + config_file.string() + " describes a " +
+              to_string(config.camera.type) + " camera (no depth_factor); it has no depth image");
 }
 
 namespace {
@@ -125,6 +130,7 @@ SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
   if (sensor) apply_sensor_override(config, *sensor, config_path);
   SequenceOptions options;
   options.stereo = config.camera.type == SensorType::stereo;
+  options.colour_only = config.camera.type == SensorType::monocular;
   options.depth_factor = config.camera.depth_factor;
   options.depth_shift_x = config.camera.depth_shift_x;
   options.depth_shift_y = config.camera.depth_shift_y;
@@ -146,11 +152,18 @@ std::string describe_sequence(const SequenceSetup& setup) {
   } else {
     std::snprintf(how, sizeof(how), "associated within %g s", s.options().max_difference);
   }
-  std::snprintf(line, sizeof(line),
-                "frames:       %zu (%zu colour and %zu %s files listed, %s; %zu listed files "
-                "missing, %zu frames skipped)\n",
-                s.size(), s.listed_rgb(), s.listed_depth(), s.stereo() ? "right" : "depth", how,
-                s.missing_files(), s.skipped_frames());
+  if (!s.options().colour_only) {
+    std::snprintf(line, sizeof(line),
+                  "frames:       %zu (%zu colour and %zu %s files listed, %s; %zu listed files "
+                  "missing, %zu frames skipped)\n",
+                  s.size(), s.listed_rgb(), s.listed_depth(), s.stereo() ? "right" : "depth", how,
+                  s.missing_files(), s.skipped_frames());
+  } else {
+    std::snprintf(line, sizeof(line),
+                  "frames:       %zu (%zu colour files listed in rgb.txt, colour only; %zu listed "
+                  "files missing, %zu frames skipped)\n",
+                  s.size(), s.listed_rgb(), s.missing_files(), s.skipped_frames());
+  }
   out << line;
   std::snprintf(line, sizeof(line), "time span:    %.3f s (%.5f .. %.5f)\n",
                 s.timestamp(s.size() - 1) - s.timestamp(0), s.timestamp(0),
@@ -162,7 +175,11 @@ std::string describe_sequence(const SequenceSetup& setup) {
     out << "ground truth: no (no groundtruth.txt)\n";
   }
   const CameraConfig& camera = setup.config.camera;
-  if (camera.type == SensorType::stereo) {
+  if (camera.type == SensorType::monocular) {
+    std::snprintf(line, sizeof(line), "config:       %s (camera '%s', monocular, %dx%d",
+                  setup.config_file.string().c_str(), camera.name.c_str(), camera.pinhole.width,
+                  camera.pinhole.height);
+  } else if (camera.type == SensorType::stereo) {
     std::snprintf(line, sizeof(line),
                   "config:       %s (camera '%s', stereo, %dx%d, baseline %.4g m, layout %s",
                   setup.config_file.string().c_str(), camera.name.c_str(), camera.pinhole.width,
@@ -173,7 +190,7 @@ std::string describe_sequence(const SequenceSetup& setup) {
                   camera.pinhole.height, camera.depth_factor);
   }
   out << line;
-  if (camera.depth_shift_x != 0 || camera.depth_shift_y != 0)
+  if (camera.type == SensorType::rgbd && (camera.depth_shift_x != 0 || camera.depth_shift_y != 0))
     out << ", depth registration shift " << camera.depth_shift_x << ", " << camera.depth_shift_y
         << " px";
   out << ")\n";

@@ -87,6 +87,9 @@ void Map::clear() {
   map_points_.clear();
   reference_map_points_.clear();
   max_keyframe_id_ = 0;
+  // A new map starts from keyframe 0 again: bundle adjustment holds keyframe 0 fixed.
+  next_keyframe_id_ = 0;
+  next_map_point_id_ = 0;
 }
 
 }  // namespace pspslam

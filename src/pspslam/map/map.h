@@ -54,6 +54,7 @@ class Map {
 
   std::mutex& update_mutex() { return update_mutex_; }
 
+  // Empties the map (a monocular restart); ids start from 0 again.
   void clear();
 
  private:

@@ -9,8 +9,19 @@ RgbdCamera RgbdCamera::from_config(const CameraConfig& camera, double virtual_ba
   RgbdCamera c;
   c.pinhole = camera.pinhole;
   // A stereo pair has a real baseline: its right coordinate is measured, not derived from depth.
-  c.bf =
-      camera.pinhole.fx * (camera.type == SensorType::stereo ? camera.baseline : virtual_baseline);
+  // A monocular camera has none: no keypoint has a depth, and a baseline would only make local
+  // mapping skip neighbours closer than it (in a map of arbitrary scale).
+  switch (camera.type) {
+    case SensorType::stereo:
+      c.bf = camera.pinhole.fx * camera.baseline;
+      break;
+    case SensorType::monocular:
+      c.bf = 0.0;
+      break;
+    case SensorType::rgbd:
+      c.bf = camera.pinhole.fx * virtual_baseline;
+      break;
+  }
   c.depth_threshold = camera.depth_threshold;
   const double w = camera.pinhole.width;
   const double h = camera.pinhole.height;

@@ -16,7 +16,7 @@ bool is_redundant(const KeyFrame& candidate, const LocalMappingOptions& options)
     if (!point) continue;
     // Only close points count: far ones are weakly constrained and say little about coverage.
     const float depth = candidate.depth(i);
-    if (depth <= 0.0f || depth > options.close_depth) continue;
+    if (options.redundancy_needs_depth && (depth <= 0.0f || depth > options.close_depth)) continue;
     ++considered;
     if (point->num_observations() <= options.redundant_observers) continue;
     const int level = candidate.keypoints()[i].octave;

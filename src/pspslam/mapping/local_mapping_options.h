@@ -29,6 +29,8 @@ struct LocalMappingOptions {
   // points are seen by at least redundant_observers other keyframes at the same or finer scale.
   double redundant_ratio = 0.9;
   int redundant_observers = 3;
+  // Only points with a close depth count towards redundancy (false: every point, monocular).
+  bool redundancy_needs_depth = true;
   bool cull_keyframes = true;
   BaOptions bundle_adjustment;
 

@@ -105,6 +105,25 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                 mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed);
   out << line;
   if (system.place.loop_closing) print_loop_stats(mapping, out);
+  if (!input.loop_closing_note.empty())
+    out << "loop closing: off (" << input.loop_closing_note << ")\n";
+  const bool monocular = input.sensor == SensorType::monocular;
+  if (monocular) {
+    if (stats.initialised_at()) {
+      const size_t since = stats.processed_since_initialisation();
+      std::snprintf(line, sizeof(line),
+                    "monocular:    map started at frame %zu; %zu of %zu frames tracked from "
+                    "there (%.1f %%), %zu map restarts\n",
+                    *stats.initialised_at(), stats.tracked_since_initialisation(), since,
+                    since > 0 ? 100.0 * stats.tracked_since_initialisation() / since : 0.0,
+                    stats.map_restarts());
+    } else {
+      std::snprintf(line, sizeof(line),
+                    "monocular:    the map never started (no two frames with enough parallax "
+                    "and matches)\n");
+    }
+    out << line;
+  }
   out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
       << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
   std::optional<AteResult> ate_tracked;
@@ -116,12 +135,14 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
         {"trajectory_refined.txt", &input.refined, &ate_refined}};
     for (const auto& [name, poses, slot] : evaluated) {
       try {
-        const AteResult ate = compute_ate(*ground_truth, *poses);
+        // A monocular map has its own scale: only a similarity aligns it.
+        const AteResult ate = compute_ate(*ground_truth, *poses, AteOptions{.sim3 = monocular});
         std::snprintf(line, sizeof(line),
-                      "ATE %s (SE(3) aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
-                      "%.4f m, max %.4f m\n",
-                      name, ate.error.count, ate.error.rmse, ate.error.mean, ate.error.median,
-                      ate.error.max);
+                      "ATE %s (%s aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
+                      "%.4f m, max %.4f m%s\n",
+                      name, monocular ? "Sim(3)" : "SE(3)", ate.error.count, ate.error.rmse,
+                      ate.error.mean, ate.error.median, ate.error.max,
+                      monocular ? (", scale " + std::to_string(ate.alignment.scale)).c_str() : "");
         out << line;
         *slot = ate;
       } catch (const Error& e) {
@@ -176,6 +197,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
 
   const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
   nlohmann::ordered_json json = {{"sequence", input.source.name()},
+                                 {"sensor", to_string(input.sensor)},
                                  {"mode", to_string(system.dynamic.mode)},
                                  {"realtime", system.dynamic.realtime},
                                  {"interrupted", input.interrupted},
@@ -183,6 +205,16 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                                  {"lost_frames", lost_count},
                                  {"relocalisations", stats.relocalisations()}};
   if (!blackout_json.is_null()) json["blackout"] = blackout_json;
+  if (input.requested_mode != system.dynamic.mode)
+    json["mode_requested"] = to_string(input.requested_mode);
+  if (monocular) {
+    json["monocular"] = {{"initialised_at_frame",
+                          stats.initialised_at() ? nlohmann::ordered_json(*stats.initialised_at())
+                                                 : nlohmann::ordered_json(nullptr)},
+                         {"frames_since_initialisation", stats.processed_since_initialisation()},
+                         {"tracked_since_initialisation", stats.tracked_since_initialisation()},
+                         {"map_restarts", stats.map_restarts()}};
+  }
   json["realtime_dropped_frames"] = stats.realtime_dropped();
   // How the input ended: a camera that was unplugged or fell silent says so here.
   json["input"] = {{"dropped_frames", source.dropped},
@@ -213,11 +245,14 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   json["loops"] = {{"enabled", system.place.loop_closing},
                    {"closed", mapping.loops_closed},
                    {"global_ba_applied", mapping.global_ba_applied}};
+  if (!input.loop_closing_note.empty()) json["loops"]["disabled_because"] = input.loop_closing_note;
   const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
       {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
   for (const auto& [key, ate] : ates) {
     if (!*ate) continue;
-    json[key] = {{"rmse", (*ate)->error.rmse},
+    json[key] = {{"alignment", monocular ? "sim3" : "se3"},
+                 {"scale", (*ate)->alignment.scale},
+                 {"rmse", (*ate)->error.rmse},
                  {"mean", (*ate)->error.mean},
                  {"median", (*ate)->error.median},
                  {"max", (*ate)->error.max},

@@ -54,6 +54,16 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     first_method_after_blackout_ = to_string(result.method);
   }
   if (!result.T_world_camera) ++lost_;
+  if (result.method == TrackingMethod::kInitialization) {
+    initialised_at_ = index;
+    tracked_since_initialisation_ = 0;
+    processed_since_initialisation_ = 0;
+  }
+  if (initialised_at_) {
+    ++processed_since_initialisation_;
+    if (result.T_world_camera) ++tracked_since_initialisation_;
+  }
+  if (result.restart_due) ++map_restarts_;
   if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
   extraction_ms.push_back(report.extraction_ms);
   tracking_ms.push_back(report.tracking_ms);

@@ -53,6 +53,12 @@ class RunStatistics {
   size_t realtime_dropped() const { return realtime_dropped_; }
   std::optional<size_t> first_pose_after_blackout() const { return first_pose_after_blackout_; }
   const std::string& first_method_after_blackout() const { return first_method_after_blackout_; }
+  // Sequence index of the frame that started the map (the last start after a monocular restart)
+  // and the frames with a pose from there on, of the frames processed from there on.
+  std::optional<size_t> initialised_at() const { return initialised_at_; }
+  size_t tracked_since_initialisation() const { return tracked_since_initialisation_; }
+  size_t processed_since_initialisation() const { return processed_since_initialisation_; }
+  size_t map_restarts() const { return map_restarts_; }
 
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;
@@ -88,6 +94,10 @@ class RunStatistics {
   double last_inference_ms_ = -1.0;
   std::optional<size_t> first_pose_after_blackout_;
   std::string first_method_after_blackout_;
+  std::optional<size_t> initialised_at_;
+  size_t tracked_since_initialisation_ = 0;
+  size_t processed_since_initialisation_ = 0;
+  size_t map_restarts_ = 0;
 };
 
 }  // namespace pspslam

@@ -67,6 +67,7 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
     : options_(std::move(options)),
       out_(out),
       input_(std::move(input)),
+      limits_(apply_sensor_limits(input_.config.camera.type, options_.system)),
       frames_(input_.source->frame_count().value_or(options_.max_frames)),
       log_(options_.outputs.folder),
       images_(options_.outputs.masks, options_.outputs.overlays),
@@ -78,12 +79,14 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
   out_ << input_.source->describe();
   out_ << "dynamic:      " << to_string(dynamic.mode)
        << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
-       << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)") << "\n";
+       << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
+       << (limits_.dynamic_note.empty() ? "" : "; " + limits_.dynamic_note) << "\n";
   if (!system.map_file.empty()) {
     out_ << "map:          " << system.map_file.string()
          << (system.localization_only ? " (localisation only)" : " (extended)") << "\n";
   }
-  out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off") << "\n";
+  out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off")
+       << (limits_.loop_closing_note.empty() ? "" : " (" + limits_.loop_closing_note + ")") << "\n";
   // Keypoint fates cost a second extraction per frame: only for the overlays.
   if (images_.writes_overlays()) {
     options_.system.record_keypoint_fates = true;
@@ -174,11 +177,15 @@ RunOutcome SequenceRunner::run() {
     const TrackResult& result = report.tracking;
     spdlog::debug(
         "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "
-        "{} dynamic",
+        "{} dynamic{}",
         i, frame.timestamp, to_string(result.state), to_string(result.method), result.num_inliers,
         result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
         report.dynamic.masked_keypoints, report.dynamic.tested_points,
-        report.dynamic.dynamic_points);
+        report.dynamic.dynamic_points,
+        result.initialization_matches > 0
+            ? fmt::format("; two-view: {} matches, {}", result.initialization_matches,
+                          to_string(result.initialization_model))
+            : std::string());
     write_images(frame, report);
     if (exporter_ && result.keyframe_inserted)
       exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
@@ -256,7 +263,11 @@ void SequenceRunner::finish(double seconds) {
                     .frames = frames_,
                     .blackout_return = blackout_return_,
                     .seconds = seconds,
-                    .interrupted = interrupted()},
+                    .interrupted = interrupted(),
+                    .sensor = input_.config.camera.type,
+                    .requested_mode = limits_.requested_mode,
+                    .dynamic_note = limits_.dynamic_note,
+                    .loop_closing_note = limits_.loop_closing_note},
                    out_);
 }
 

@@ -14,6 +14,7 @@
 #include "pspslam/session/run_observer.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
+#include "pspslam/system/frame_builder.h"
 #include "pspslam/system/map_export.h"
 #include "pspslam/system/system.h"
 
@@ -65,6 +66,8 @@ class SequenceRunner {
   RunOptions options_;
   std::ostream& out_;
   RunInput input_;
+  // What the sensor cannot run, taken out of options_.system before anything else reads it.
+  SensorLimits limits_;
   size_t frames_ = 0;     // frames to process; 0 = until the source ends
   size_t delivered_ = 0;  // frames taken from the source
   std::optional<Timestamp> blackout_return_;

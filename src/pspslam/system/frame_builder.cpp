@@ -158,7 +158,74 @@ class StereoFrameBuilder final : public FrameBuilder {
   std::future<cv::Mat> dense_;
 };
 
+// One colour image: the RGB-D extraction without a depth image. No keypoint has a depth, so the
+// map starts from two views with parallax (tracking/map_initializer.h) and local mapping makes
+// points by triangulation only. depth_image() is empty: the geometry stage needs a dense depth
+// image of the frame and of its reference keyframes, which a single camera does not have
+// (apply_sensor_limits runs the modes with geometry without it); the culler does nothing
+// without one. The semantic mask masks the one image's extraction, as for RGB-D.
+class MonocularFrameBuilder final : public FrameBuilder {
+ public:
+  MonocularFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
+                        std::shared_ptr<const ScalePyramid> pyramid)
+      : extractor_(orb), camera_(std::move(camera)), pyramid_(std::move(pyramid)) {}
+
+  void extract(const RgbdFrame&, const cv::Mat& gray, const cv::Mat& mask,
+               OrbFeatures& features) override {
+    extractor_.extract(gray, mask, features);
+  }
+
+  cv::Mat depth_image(const RgbdFrame&) override { return {}; }
+
+  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
+              const cv::Mat&) override {
+    return Frame(id, frame.timestamp, std::move(features.keypoints),
+                 std::move(features.descriptors), cv::Mat(), camera_, pyramid_);
+  }
+
+  std::unique_ptr<MapInitializer> make_map_initializer(const TrackerOptions&) const override {
+    return make_monocular_map_initializer();
+  }
+
+  void adapt(LocalMappingOptions& options) const override {
+    // ORB-SLAM's monocular rules: a recent point seen by at most 2 keyframes is culled (3 with
+    // depth, where an observation with depth counts as two views), and keyframe redundancy
+    // counts every point, there being no "close" ones.
+    options.min_observations = 2;
+    options.redundancy_needs_depth = false;
+  }
+
+ private:
+  OrbExtractor extractor_;
+  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const ScalePyramid> pyramid_;
+};
+
 }  // namespace
+
+SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options) {
+  SensorLimits limits;
+  limits.requested_mode = options.dynamic.mode;
+  if (type != SensorType::monocular) return limits;
+  // The geometry stage compares the frame's depth with its reference keyframes' depth images
+  // around projected pixels (geometry/multiview_test.h); a single camera has neither. The modes
+  // keep their meaning for the part that can run: semantic stays semantic, full and exhaustive
+  // run their semantic half, geometry alone runs nothing.
+  const DynamicMode mode = options.dynamic.mode;
+  if (uses_geometry(mode)) {
+    options.dynamic.mode = uses_semantics(mode) ? DynamicMode::semantic : DynamicMode::off;
+    limits.dynamic_note = std::string(to_string(mode)) + " runs as " +
+                          to_string(options.dynamic.mode) +
+                          " (monocular: the geometry stage needs depth images)";
+  }
+  if (options.place.loop_closing) {
+    // A monocular loop needs a Sim(3) correction for the scale drift; the loop corrector is
+    // SE(3) (loop/loop_corrector.h), which would bend a drifted map at the loop.
+    options.place.loop_closing = false;
+    limits.loop_closing_note = "monocular: Sim(3) correction not implemented";
+  }
+  return limits;
+}
 
 std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
                                                  std::shared_ptr<const RgbdCamera> camera,
@@ -167,6 +234,10 @@ std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
   if (config.camera.type == SensorType::stereo) {
     return std::make_unique<StereoFrameBuilder>(config.orb, std::move(camera), std::move(pyramid),
                                                 dense_depth);
+  }
+  if (config.camera.type == SensorType::monocular) {
+    return std::make_unique<MonocularFrameBuilder>(config.orb, std::move(camera),
+                                                   std::move(pyramid));
   }
   return std::make_unique<RgbdFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
 }

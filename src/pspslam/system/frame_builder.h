@@ -3,11 +3,15 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "pspslam/config/config.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/map/frame.h"
+#include "pspslam/mapping/local_mapping_options.h"
+#include "pspslam/system/system.h"
+#include "pspslam/tracking/map_initializer.h"
 
 namespace pspslam {
 
@@ -15,7 +19,9 @@ namespace pspslam {
 // place (issue #16): past the Frame, tracking, mapping and loop closing treat every keypoint
 // alike, with a depth and a right coordinate u_r = u - bf / z (measured for stereo, derived from
 // the depth image with a virtual baseline for RGB-D), so the same stereo reprojection residual
-// serves both sensors in pose optimisation and bundle adjustment.
+// serves both sensors in pose optimisation and bundle adjustment. A monocular keypoint has no
+// depth (< 0, right u NaN) and gets the 2-row residual everywhere; the sensors also differ in
+// how the map starts (make_map_initializer) and in a few local mapping rules (adapt).
 //
 // System drives it per frame: extract -> [dynamic pipeline: depth_image, remove_dynamic] -> build.
 class FrameBuilder {
@@ -36,7 +42,24 @@ class FrameBuilder {
   // depth_image() returned, or empty when no dynamic pipeline runs.
   virtual Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
                       const cv::Mat& depth) = 0;
+
+  // How the map starts: one frame with depth (RGB-D, stereo) or two views (monocular).
+  virtual std::unique_ptr<MapInitializer> make_map_initializer(
+      const TrackerOptions& options) const {
+    return make_depth_map_initializer(options.min_initial_depth_points);
+  }
+  // Local mapping rules that depend on depth readings.
+  virtual void adapt(LocalMappingOptions&) const {}
 };
+
+// What a sensor cannot run, taken out of the run's options before the System starts, with the
+// reason the run summary prints (empty: nothing changed).
+struct SensorLimits {
+  DynamicMode requested_mode = DynamicMode::off;
+  std::string dynamic_note;       // e.g. "full runs as semantic (monocular: ...)"
+  std::string loop_closing_note;  // e.g. "monocular: Sim(3) correction not implemented"
+};
+SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options);
 
 // The builder of `config.camera.type`. `dense_depth`: depth_image() will be called every frame
 // (a dynamic pipeline runs), so a stereo builder computes it beside the extraction.

@@ -177,6 +177,9 @@ System::System(const SystemConfig& config, SystemOptions options)
           make_frame_builder(config, camera_, pyramid_, options.dynamic.mode != DynamicMode::off)),
       extractor_(std::make_unique<OrbExtractor>(config.orb)),
       map_(std::make_shared<Map>()) {
+  // What this sensor cannot run (the runner applied it already to print why; again here for
+  // callers that build a System directly).
+  apply_sensor_limits(config.camera.type, options);
   if (options.localization_only) {
     // Nothing may change the map: no keyframes means nothing for these threads to do.
     options.local_mapping = false;
@@ -199,6 +202,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
       mapping_options.bundle_adjustment.depth_noise = {.enabled = true,
                                                        .scale = config.camera.depth_noise_scale};
+    frame_builder_->adapt(mapping_options);
     mapping = std::make_unique<LocalMapping>(map_, mapping_options, place_);
   }
   mapping_ = std::make_unique<MappingConnection>(std::move(mapping), place_);
@@ -208,7 +212,8 @@ System::System(const SystemConfig& config, SystemOptions options)
     options.tracker.pose_optimizer.depth_noise = {.enabled = true,
                                                   .scale = config.camera.depth_noise_scale};
   tracker_ = std::make_unique<Tracker>(*map_, mapping_.get(), options.tracker,
-                                       options.place.relocalization ? place_ : nullptr);
+                                       options.place.relocalization ? place_ : nullptr,
+                                       frame_builder_->make_map_initializer(options.tracker));
   if (!options.map_file.empty()) {
     load_map(options.map_file, *map_, camera_, pyramid_);
     if (place_) {
@@ -263,6 +268,7 @@ FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
   wait_for_local_mapping_if_synchronous();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
+  if (report.tracking.restart_due) restart_map();
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
   return report;
@@ -319,6 +325,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
+  if (report.tracking.restart_due) restart_map();
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
   // The culler below and the next frame's geometry stage read map points and keyframe poses that
@@ -355,6 +362,17 @@ void System::record_fates_of_tracked_frame(std::vector<KeypointRecord>& records)
     records.push_back({keypoints[i].pt,
                        tracked->map_points[i] ? KeypointFate::tracked : KeypointFate::unmatched});
   }
+}
+
+void System::restart_map() {
+  // Local mapping may still hold keyframes of the map about to go: let it finish them first.
+  mapping_->wait_until_idle();
+  std::lock_guard lock(map_->update_mutex());
+  if (place_) {
+    for (const auto& keyframe : map_->keyframes()) place_->database().erase(keyframe->id());
+  }
+  map_->clear();
+  tracker_->restart();
 }
 
 void System::wait_for_local_mapping_if_synchronous() {

@@ -171,6 +171,9 @@ class System {
   class MappingConnection;
 
   void wait_for_local_mapping_if_synchronous();
+  // TrackResult::restart_due: local mapping finishes, the map and the keyframe database are
+  // emptied and the tracker starts a new map with the next frames.
+  void restart_map();
   void record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
                                    std::vector<KeypointRecord>& records);
   void record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const;

@@ -44,14 +44,19 @@ const char* to_string(TrackingMethod method) {
 }
 
 Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
-                 std::shared_ptr<PlaceRecognition> place)
+                 std::shared_ptr<PlaceRecognition> place,
+                 std::unique_ptr<MapInitializer> initializer)
     : map_(map),
       sink_(sink),
       options_(std::move(options)),
-      local_map_(options_.max_local_keyframes) {
+      local_map_(options_.max_local_keyframes),
+      initializer_(initializer ? std::move(initializer)
+                               : make_depth_map_initializer(options_.min_initial_depth_points)) {
   if (place)
     relocalizer_ = std::make_unique<Relocalizer>(map_, std::move(place), options_.relocalizer);
 }
+
+Tracker::~Tracker() = default;
 
 TrackResult Tracker::track(Frame frame) {
   std::lock_guard map_lock(map_.update_mutex());
@@ -100,6 +105,7 @@ TrackResult Tracker::track(Frame frame) {
       state_ = TrackingState::kLost;
       result.method = TrackingMethod::kNone;
       frame.clear_pose();
+      result.restart_due = map_.num_keyframes() <= initializer_->restart_when_lost_below();
     }
   }
 
@@ -163,18 +169,36 @@ std::optional<Pose> Tracker::last_tracked_world_pose() const {
 }
 
 bool Tracker::initialize(Frame& frame, TrackResult& result) {
-  int with_depth = 0;
-  for (int i = 0; i < frame.size(); ++i) with_depth += frame.depth(i) > 0.0f ? 1 : 0;
-  result.keypoints_with_depth = with_depth;
-  result.keypoints_with_depth_needed = options_.min_initial_depth_points;
-  if (with_depth < options_.min_initial_depth_points) return false;
-  // The first camera defines the world frame.
-  frame.set_pose(Pose::Identity());
-  reference_keyframe_ = create_keyframe(frame, map_, /*initial=*/true);
+  InitializationProgress progress;
+  const std::vector<std::shared_ptr<KeyFrame>> keyframes =
+      initializer_->initialize(frame, map_, progress);
+  result.keypoints_with_depth = progress.keypoints_with_depth;
+  result.keypoints_with_depth_needed = progress.keypoints_with_depth_needed;
+  result.initialization_matches = progress.initialization_matches;
+  result.initialization_model = progress.model;
+  if (keyframes.empty()) return false;
+  reference_keyframe_ = keyframes.back();
   last_keyframe_frame_id_ = frame.id();
   local_map_.update(frame);
-  if (sink_ != nullptr) sink_->insert_keyframe(reference_keyframe_);
+  if (sink_ != nullptr) {
+    for (const auto& keyframe : keyframes) sink_->insert_keyframe(keyframe);
+  }
   return true;
+}
+
+void Tracker::restart() {
+  state_ = TrackingState::kNotInitialized;
+  last_frame_.reset();
+  velocity_.reset();
+  motion_prior_.reset();
+  last_tracked_pose_.reset();
+  reference_keyframe_.reset();
+  last_keyframe_frame_id_ = 0;
+  last_recovery_frame_id_ = 0;
+  local_map_ = LocalMap(options_.max_local_keyframes);
+  anchors_.clear();
+  initializer_->reset();
+  ++restarts_;
 }
 
 void Tracker::replace_replaced_points(Frame& frame) const {

@@ -12,6 +12,7 @@
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_policy.h"
 #include "pspslam/tracking/local_map.h"
+#include "pspslam/tracking/map_initializer.h"
 #include "pspslam/tracking/relocalizer.h"
 
 namespace pspslam {
@@ -22,7 +23,7 @@ class Map;
 class PlaceRecognition;
 
 struct TrackerOptions {
-  int min_initial_depth_points = 500;  // keypoints with depth needed to start the map
+  int min_initial_depth_points = 500;  // keypoints with depth needed to start the map (RGB-D)
   double motion_search_radius = 7.0;   // pixels at level 0 (ORB-SLAM2 RGB-D)
   int min_motion_matches = 20;         // below: search again with twice the radius
   int min_pose_inliers = 10;           // motion model / reference keyframe success
@@ -78,6 +79,13 @@ struct TrackResult {
   // map needs (so a caller can say why a sequence never starts, e.g. empty depth images).
   int keypoints_with_depth = 0;
   int keypoints_with_depth_needed = 0;
+  // Monocular, before the map exists: matches with the initialiser's reference frame and the
+  // two-view model tried on them (none: no attempt).
+  int initialization_matches = 0;
+  TwoViewModel initialization_model = TwoViewModel::none;
+  // Tracking was lost while the map was this young (MapInitializer::restart_when_lost_below):
+  // the caller stops local mapping's work and calls Tracker::restart().
+  bool restart_due = false;
 };
 
 // Tracking of each frame (ORB-SLAM2 RGB-D semantics): map initialisation from the first frame
@@ -93,9 +101,13 @@ struct TrackResult {
 class Tracker {
  public:
   // `map` and `sink` must outlive the tracker; `sink` may be null (no local mapping); `place`
-  // may be null (no relocalisation through the keyframe database).
+  // may be null (no relocalisation through the keyframe database). `initializer`: how the map
+  // starts (the sensor's, system/frame_builder.h); null: from depth, one frame with
+  // options.min_initial_depth_points keypoints with depth.
   Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options = {},
-          std::shared_ptr<PlaceRecognition> place = nullptr);
+          std::shared_ptr<PlaceRecognition> place = nullptr,
+          std::unique_ptr<MapInitializer> initializer = nullptr);
+  ~Tracker();
 
   TrackResult track(Frame frame);
 
@@ -120,6 +132,12 @@ class Tracker {
   // new map. Call before the first track(). Throws pspslam::Error without a PlaceRecognition
   // (nothing else can find the camera in an existing map) or with an empty map.
   void start_in_loaded_map();
+
+  // Forgets the map the tracker knew (after TrackResult::restart_due; the caller has emptied the
+  // map and local mapping's queue): the next frames start a new map. Frames tracked before stay
+  // out of refined_trajectory(), since the new map has its own world frame (and scale).
+  void restart();
+  int restarts() const { return restarts_; }
 
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
@@ -154,6 +172,8 @@ class Tracker {
   std::uint64_t last_recovery_frame_id_ = 0;
   LocalMap local_map_;
   std::unique_ptr<Relocalizer> relocalizer_;  // null without a vocabulary
+  std::unique_ptr<MapInitializer> initializer_;
+  int restarts_ = 0;
 
   struct FrameAnchor {
     Timestamp timestamp = 0.0;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,33 +26,41 @@ namespace pspslam::cli {
 
 namespace {
 
-// Names the run in plot titles: `--title` when given; else "<sequence folder>, mode <mode>" from
-// the stats.json that `pspslam run` writes beside its trajectories; else nothing. A stats.json
-// that does not parse only loses the name (the evaluation itself does not need it).
-std::string plot_run_name(const std::string& title, const std::string& estimate_file) {
-  if (!title.empty()) return title;
+// The stats.json that `pspslam run` writes beside its trajectories, when there is one. One that
+// does not parse only loses what eval reads from it (a plot title, the automatic Sim(3)): the
+// evaluation itself does not need it.
+std::optional<nlohmann::json> run_stats(const std::string& estimate_file) {
   const std::filesystem::path stats_file =
       std::filesystem::path(estimate_file).parent_path() / "stats.json";
   std::error_code failure;
-  if (!std::filesystem::is_regular_file(stats_file, failure)) return {};
+  if (!std::filesystem::is_regular_file(stats_file, failure)) return std::nullopt;
   try {
     std::ifstream stream(stats_file);
-    const nlohmann::json stats = nlohmann::json::parse(stream);
-    std::string name;
-    if (stats.contains("sequence") && stats["sequence"].is_string()) {
-      // `run` records the sequence folder; its last component names the sequence.
-      std::filesystem::path sequence = stats["sequence"].get<std::string>();
-      if (!sequence.has_filename()) sequence = sequence.parent_path();
-      name = sequence.filename().string();
-    }
-    if (stats.contains("mode") && stats["mode"].is_string()) {
-      name += (name.empty() ? "" : ", ") + std::string("mode ") + stats["mode"].get<std::string>();
-    }
-    return name;
+    return nlohmann::json::parse(stream);
   } catch (const nlohmann::json::exception& e) {
-    spdlog::warn("{}: not read for the plot titles: {}", stats_file.string(), e.what());
-    return {};
+    spdlog::warn("{}: not read for the plot titles or the alignment: {}", stats_file.string(),
+                 e.what());
+    return std::nullopt;
   }
+}
+
+// Names the run in plot titles: `--title` when given; else "<sequence folder>, mode <mode>" from
+// the run's stats.json; else nothing.
+std::string plot_run_name(const std::string& title, const std::optional<nlohmann::json>& run) {
+  if (!title.empty()) return title;
+  if (!run) return {};
+  const nlohmann::json& stats = *run;
+  std::string name;
+  if (stats.contains("sequence") && stats["sequence"].is_string()) {
+    // `run` records the sequence folder; its last component names the sequence.
+    std::filesystem::path sequence = stats["sequence"].get<std::string>();
+    if (!sequence.has_filename()) sequence = sequence.parent_path();
+    name = sequence.filename().string();
+  }
+  if (stats.contains("mode") && stats["mode"].is_string()) {
+    name += (name.empty() ? "" : ", ") + std::string("mode ") + stats["mode"].get<std::string>();
+  }
+  return name;
 }
 
 std::string rpe_delta_text(const RpeOptions& rpe) {
@@ -61,8 +70,23 @@ std::string rpe_delta_text(const RpeOptions& rpe) {
   return buffer;
 }
 
-int evaluate(const EvalSettings& settings, bool json, const std::string& plot,
-             const std::string& title) {
+// A monocular run's trajectory has its own scale: unless --sim3 was given, its stats.json
+// (`sensor: monocular`) turns Sim(3) alignment on, and the report says why.
+void choose_alignment(EvalSettings& settings, const std::optional<nlohmann::json>& stats) {
+  if (settings.ate.sim3) {
+    settings.alignment_reason = "--sim3";
+    return;
+  }
+  if (stats && stats->is_object() && stats->contains("sensor") &&
+      (*stats)["sensor"] == "monocular") {
+    settings.ate.sim3 = true;
+    settings.alignment_reason = "the run's stats.json says sensor monocular";
+  }
+}
+
+int evaluate(EvalSettings settings, bool json, const std::string& plot, const std::string& title) {
+  const std::optional<nlohmann::json> stats = run_stats(settings.estimate_file);
+  choose_alignment(settings, stats);
   if (!plot.empty()) prepare_output_folder(plot, "--plot");
   Trajectory ground_truth = read_tum_trajectory(settings.ground_truth_file);
   if (!settings.gt_body_to_camera_file.empty()) {
@@ -79,7 +103,7 @@ int evaluate(const EvalSettings& settings, bool json, const std::string& plot,
                      : format_eval_table(settings, ate, rpe));
   if (!plot.empty()) {
     EvalPlotOptions options;
-    options.run_name = plot_run_name(title, settings.estimate_file);
+    options.run_name = plot_run_name(title, stats);
     options.alignment_name = settings.ate.sim3 ? "Sim(3)" : "SE(3)";
     options.rpe_delta = rpe_delta_text(settings.rpe);
     const EvalPlotFiles files = write_eval_plots(ground_truth, estimate, ate, rpe, plot, options);

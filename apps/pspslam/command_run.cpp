@@ -35,6 +35,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/io/sequence_setup.h"
+#include "pspslam/io/video_source.h"
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
@@ -119,6 +120,7 @@ OverlayClasses overlay_classes(const DynamicOptions& dynamic) {
 struct RunFlags {
   std::string sequence;
   std::string camera;
+  std::string video;  // --video FILE|INDEX (monocular)
   std::string config;
   std::string sensor;  // empty: the config's camera.type
   std::string trajectory_format = "tum";
@@ -208,6 +210,13 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     if (options.sensor) apply_sensor_override(camera->config, *options.sensor, camera->config_file);
     camera->source = open_camera(spec);
   }
+  if (!flags.video.empty()) {
+    camera.emplace();
+    camera->config_file = flags.config;
+    camera->config = load_config(camera->config_file);
+    apply_sensor_override(camera->config, SensorType::monocular, camera->config_file);
+    camera->source = open_video(flags.video, camera->config.camera.fps);
+  }
   // The viewer binds its address before the model and the sequence load, so a port in use is
   // told at once; it outlives the runner, which only points to it.
   std::unique_ptr<LiveViewer> viewer;
@@ -219,7 +228,9 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     live.start_paused = flags.viewer_paused;
     live.realtime = flags.realtime;
     live.classes = overlay_classes(dynamic);
-    live.title = flags.camera.empty() ? flags.sequence : "camera " + flags.camera;
+    live.title = !flags.video.empty()   ? "video " + flags.video
+                 : flags.camera.empty() ? flags.sequence
+                                        : "camera " + flags.camera;
     if (!flags.sequence.empty() &&
         std::filesystem::is_regular_file(std::filesystem::path(flags.sequence) / "groundtruth.txt"))
       live.ground_truth = std::filesystem::path(flags.sequence) / "groundtruth.txt";
@@ -254,14 +265,26 @@ Command add_run_command(CLI::App& root) {
       "OUT/stats.json. With ground truth, prints ATE.");
   auto flags = std::make_shared<RunFlags>();
   CLI::Option* sequence = app->add_option("--sequence", flags->sequence, "sequence folder");
-  app->add_option("--camera", flags->camera,
-                  "read a live camera instead of a folder: freenect[:INDEX] (Kinect v1 through "
-                  "libfreenect; config: --config, else config/kinect_v1.yaml)")
-      ->excludes(sequence);
+  CLI::Option* camera = app->add_option("--camera", flags->camera,
+                                        "read a live camera instead of a folder: "
+                                        "freenect[:INDEX] (Kinect v1 through libfreenect; "
+                                        "config: --config, else config/kinect_v1.yaml)")
+                            ->excludes(sequence);
+  app->add_option("--video", flags->video,
+                  "monocular SLAM on a video file or a camera index (OpenCV VideoCapture; time "
+                  "stamps from the file, else frame index / fps); needs --config for the "
+                  "intrinsics")
+      ->excludes(sequence)
+      ->excludes(camera);
   // One input is required; checked while parsing, so nothing is created without one.
   app->callback([flags] {
-    if (flags->sequence.empty() && flags->camera.empty())
-      throw CLI::RequiredError("--sequence (or --camera)");
+    if (flags->sequence.empty() && flags->camera.empty() && flags->video.empty())
+      throw CLI::RequiredError("--sequence (or --camera or --video)");
+    if (!flags->video.empty() && flags->config.empty())
+      throw CLI::ValidationError("--video", "needs --config (the camera's intrinsics)");
+    if (!flags->video.empty() && !flags->sensor.empty() && flags->sensor != "monocular")
+      throw CLI::ValidationError(
+          "--video", "is monocular; --sensor " + flags->sensor + " needs a sequence folder");
   });
   app->add_option("--config", flags->config,
                   "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "

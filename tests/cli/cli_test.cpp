@@ -7,6 +7,7 @@
 #include <iostream>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/io/point_cloud_ply.h"
@@ -571,6 +572,89 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
 }
 
 // A mistyped config key is named, with the key it probably meant.
+// --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own
+// encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
+// 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
+TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
+  const auto dir = testing::make_temp_dir("cli_video");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 120 --bodies 0 --seed 3");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  cv::VideoWriter writer((dir / "seq.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                         30.0, cv::Size(640, 480));
+  ASSERT_TRUE(writer.isOpened());
+  std::ifstream list(dir / "seq" / "rgb.txt");
+  int written = 0;
+  for (std::string line; std::getline(list, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::string file = line.substr(line.find(' ') + 1);
+    writer.write(cv::imread((dir / "seq" / file).string()));
+    ++written;
+  }
+  writer.release();
+  ASSERT_EQ(written, 120);
+
+  const auto out = dir / "out";
+  const Result run =
+      pspslam("run --video " + (dir / "seq.avi").string() + " --config " +
+              (dir / "seq" / "config.yaml").string() + " --dynamic off --out " + out.string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(
+      run.output, "video:        " + (dir / "seq.avi").string() + " (file, 120 frames, 30 fps"))
+      << run.output;
+  EXPECT_TRUE(
+      contains(run.output, "loop closing: off (monocular: Sim(3) correction not implemented)"))
+      << run.output;
+  const Trajectory trajectory = read_tum_trajectory(out / "trajectory.txt");
+  // The map starts within the first 30 frames and every frame after is tracked.
+  ASSERT_GE(trajectory.size(), 90u) << run.output;
+  for (size_t i = 1; i < trajectory.size(); ++i)
+    EXPECT_NEAR(trajectory[i].timestamp - trajectory[i - 1].timestamp, 1.0 / 30.0, 1e-3);
+  EXPECT_NEAR(trajectory.back().timestamp, 119.0 / 30.0, 1e-3);
+  const nlohmann::json stats = nlohmann::json::parse(read_text(out / "stats.json"));
+  EXPECT_EQ(stats["sensor"], "monocular");
+  EXPECT_EQ(stats["monocular"]["map_restarts"], 0);
+  EXPECT_LE(stats["monocular"]["initialised_at_frame"].get<int>(), 30);
+
+  // The synthetic ground truth starts at t = 1000000 s, the video at 0.
+  Trajectory ground_truth = read_tum_trajectory(dir / "seq" / "groundtruth.txt");
+  const Timestamp start = ground_truth.front().timestamp;
+  for (StampedPose& pose : ground_truth) pose.timestamp -= start;
+  write_tum_trajectory(dir / "gt.txt", ground_truth);
+  const std::string files =
+      " --gt " + (dir / "gt.txt").string() + " --est " + (out / "trajectory.txt").string();
+  const Result table = pspslam("eval" + files);
+  ASSERT_EQ(table.status, 0) << table.output;
+  EXPECT_TRUE(contains(table.output,
+                       "alignment:    Sim(3) (the run's stats.json says sensor monocular), scale "))
+      << table.output;
+  const Result json = pspslam("eval" + files + " --json");
+  ASSERT_EQ(json.status, 0) << json.output;
+  const nlohmann::json report =
+      nlohmann::json::parse(json.output.substr(0, json.output.rfind("}") + 1));
+  EXPECT_EQ(report["ate"]["alignment"], "sim3");
+  EXPECT_EQ(report["ate"]["alignment_reason"], "the run's stats.json says sensor monocular");
+  EXPECT_LT(report["ate"]["error_m"]["rmse"].get<double>(), 0.05);
+
+  // Errors: no intrinsics, a file that is not there, another sensor.
+  Result bad =
+      pspslam("run --video " + (dir / "seq.avi").string() + " --out " + (dir / "bad").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.output, "needs --config (the camera's intrinsics)")) << bad.output;
+  bad = pspslam("run --video " + (dir / "missing.avi").string() + " --config " +
+                (dir / "seq" / "config.yaml").string() + " --out " + (dir / "bad").string());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_TRUE(
+      contains(bad.output, "--video " + (dir / "missing.avi").string() + ": file not found"))
+      << bad.output;
+  bad = pspslam("run --video " + (dir / "seq.avi").string() + " --config " +
+                (dir / "seq" / "config.yaml").string() + " --sensor stereo --out " +
+                (dir / "bad").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.output, "is monocular; --sensor stereo needs a sequence folder"))
+      << bad.output;
+}
+
 TEST(CliRun, MistypedConfigKeyIsNamedWithASuggestion) {
   const auto dir = make_sequence("cli_typo", false);
   std::ofstream(dir / "typo.yaml")

@@ -176,13 +176,10 @@ TEST(Config, StereoCameraReadsBaselineOrBfAndRoundTrips) {
 
 TEST(Config, StereoErrorsNameFileLineAndKey) {
   const auto dir = testing::make_temp_dir("config_stereo_errors");
-  auto file = write_file(dir, replace(kStereoCamera, "  type: stereo\n", "  type: monocular\n"));
+  auto file = write_file(dir, replace(kStereoCamera, "  type: stereo\n", "  type: lidar\n"));
   EXPECT_EQ(load_error(file), file.string() +
-                                  ":3: key 'camera.type': monocular is not supported yet (issue "
-                                  "#16); use rgbd or stereo");
-  file = write_file(dir, replace(kStereoCamera, "  type: stereo\n", "  type: lidar\n"));
-  EXPECT_EQ(load_error(file),
-            file.string() + ":3: key 'camera.type': must be rgbd or stereo, got 'lidar'");
+                                  ":3: key 'camera.type': must be rgbd, stereo or monocular, got "
+                                  "'lidar'");
   file = write_file(dir, replace(kStereoCamera, "  baseline: 0.12\n", ""));
   EXPECT_EQ(load_error(file), file.string() +
                                   ": a stereo camera needs exactly one of 'camera.baseline' "
@@ -204,6 +201,30 @@ TEST(Config, StereoErrorsNameFileLineAndKey) {
   EXPECT_EQ(load_error(file), file.string() +
                                   ":13: unknown key 'camera.basline' (did you mean "
                                   "'camera.baseline'?)");
+}
+
+// Monocular (issue #16): intrinsics and fps only; depth and baseline keys are named as another
+// sensor's.
+TEST(Config, MonocularCameraRoundTripsAndRefusesDepthAndBaselineKeys) {
+  const auto dir = testing::make_temp_dir("config_monocular");
+  const std::string monocular = replace(
+      replace(kStereoCamera, "  type: stereo\n", "  type: monocular\n"), "  baseline: 0.12\n", "");
+  const SystemConfig config = load_config(write_file(dir, monocular));
+  EXPECT_EQ(config.camera.type, SensorType::monocular);
+  EXPECT_EQ(to_string(config.camera.type), "monocular");
+  save_config(dir / "saved.yaml", config);
+  const SystemConfig back = load_config(dir / "saved.yaml");
+  EXPECT_EQ(back.camera.type, SensorType::monocular);
+  EXPECT_DOUBLE_EQ(back.camera.pinhole.fx, 500.0);
+  auto file =
+      write_file(dir, replace(monocular, "  fps: 20\n", "  fps: 20\n  depth_factor: 5000\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":12: key 'camera.depth_factor' is for rgbd cameras only "
+                                  "(camera.type is monocular)");
+  file = write_file(dir, replace(monocular, "  fps: 20\n", "  fps: 20\n  baseline: 0.1\n"));
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":12: key 'camera.baseline' has no meaning for a monocular "
+                                  "camera (camera.type is monocular)");
 }
 
 TEST(Config, UnknownKeyNamesFileLineAndKey) {

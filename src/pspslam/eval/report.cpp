@@ -51,8 +51,9 @@ std::string format_eval_table(const EvalSettings& settings, const AteResult& ate
   out << "estimate:     " << settings.estimate_file << "\n";
   out << "association:  max dt " << short_number(settings.ate.max_difference) << " s, offset "
       << short_number(settings.ate.offset) << " s\n";
-  out << "alignment:    " << (settings.ate.sim3 ? "Sim(3)" : "SE(3)") << ", scale "
-      << fixed(ate.alignment.scale, 6) << "\n";
+  out << "alignment:    " << (settings.ate.sim3 ? "Sim(3)" : "SE(3)")
+      << (settings.alignment_reason.empty() ? "" : " (" + settings.alignment_reason + ")")
+      << ", scale " << fixed(ate.alignment.scale, 6) << "\n";
   out << "RPE delta:    " << short_number(settings.rpe.delta) << " "
       << (settings.rpe.unit == RpeDeltaUnit::seconds ? "s" : "frames") << "\n\n";
   char header[256];
@@ -87,6 +88,7 @@ std::string format_eval_json(const EvalSettings& settings, const AteResult& ate,
                                 : nlohmann::ordered_json(settings.gt_body_to_camera_file)},
       {"ate",
        {{"alignment", settings.ate.sim3 ? "sim3" : "se3"},
+        {"alignment_reason", settings.alignment_reason},
         {"max_dt_s", settings.ate.max_difference},
         {"offset_s", settings.ate.offset},
         {"scale", ate.alignment.scale},

@@ -16,6 +16,9 @@ struct EvalSettings {
   std::string gt_body_to_camera_file;
   AteOptions ate;
   RpeOptions rpe;
+  // Why ate.sim3 is what it is, printed beside the alignment: "--sim3", or the run's stats.json
+  // saying monocular (`pspslam eval` turns Sim(3) on then); empty: the default, SE(3).
+  std::string alignment_reason;
 };
 
 // Human-readable ATE/RPE table (fixed-width, units in every row).

@@ -636,6 +636,23 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   EXPECT_EQ(report["ate"]["alignment_reason"], "the run's stats.json says sensor monocular");
   EXPECT_LT(report["ate"]["error_m"]["rmse"].get<double>(), 0.05);
 
+  // The same frames from the folder, colour only. Black frames two frames after the map started
+  // lose a map of a few keyframes: it is started again after them rather than relocalised into.
+  const Result folder = pspslam("run --sequence " + (dir / "seq").string() +
+                                " --sensor monocular --dynamic off --out " + (dir / "f").string());
+  ASSERT_EQ(folder.status, 0) << folder.output;
+  const int started = nlohmann::json::parse(
+      read_text(dir / "f" / "stats.json"))["monocular"]["initialised_at_frame"];
+  const Result blackout = pspslam(
+      "run --sequence " + (dir / "seq").string() + " --sensor monocular --dynamic off --blackout " +
+      std::to_string(started + 2) + ":10 --out " + (dir / "b").string());
+  ASSERT_EQ(blackout.status, 0) << blackout.output;
+  const nlohmann::json restarted = nlohmann::json::parse(read_text(dir / "b" / "stats.json"));
+  EXPECT_EQ(restarted["monocular"]["map_restarts"], 1) << blackout.output;
+  EXPECT_GT(restarted["monocular"]["initialised_at_frame"].get<int>(), started + 11);
+  EXPECT_EQ(restarted["monocular"]["tracked_since_initialisation"],
+            restarted["monocular"]["frames_since_initialisation"]);
+
   // Errors: no intrinsics, a file that is not there, another sensor.
   Result bad =
       pspslam("run --video " + (dir / "seq.avi").string() + " --out " + (dir / "bad").string());

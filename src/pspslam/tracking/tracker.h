@@ -88,13 +88,15 @@ struct TrackResult {
   bool restart_due = false;
 };
 
-// Tracking of each frame (ORB-SLAM2 RGB-D semantics): map initialisation from the first frame
-// with enough depth, constant-velocity motion model, reference-keyframe fallback, local map
-// tracking, keyframe decision. When tracking fails the frame is reported lost and the next
-// frames are relocalised against the whole map through the keyframe database (Relocalizer,
-// when a PlaceRecognition is given), else / then against the last reference keyframe (PnP-RANSAC
-// from brute-force matches, since the last pose may be stale); no new map is started, so all
-// poses stay in one world frame.
+// Tracking of each frame (ORB-SLAM2 semantics): map initialisation by the sensor's
+// MapInitializer (the first frame with enough depth, or two monocular views), constant-velocity
+// motion model, reference-keyframe fallback, local map tracking, keyframe decision. When
+// tracking fails the frame is reported lost and the next frames are relocalised against the
+// whole map through the keyframe database (Relocalizer, when a PlaceRecognition is given), else /
+// then against the last reference keyframe (PnP-RANSAC from brute-force matches, since the last
+// pose may be stale). No new map is started, so all poses stay in one world frame, except that
+// a monocular map lost while it has at most MapInitializer::restart_when_lost_below() keyframes
+// is restarted (TrackResult::restart_due).
 //
 // Not thread-safe: one thread calls track(). It holds map.update_mutex() while it works on a
 // frame, so local mapping cannot rewrite poses or points under it.

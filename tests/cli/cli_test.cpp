@@ -252,9 +252,9 @@ TEST(CliEval, GroundTruthBodyToCamera) {
 TEST(CliRun, MissingSequenceFlagAndConfig) {
   Result r = pspslam("run");
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(
-      r.output,
-      "error: pspslam run: --sequence (or --camera) is required (see 'pspslam run --help')\n");
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --sequence (or --camera or --video) is required (see 'pspslam run "
+            "--help')\n");
   const auto dir = make_sequence("cli", false);
   r = pspslam("run --sequence " + dir.string());
   EXPECT_EQ(r.status, 2);

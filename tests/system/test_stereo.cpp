@@ -138,15 +138,23 @@ TEST(Stereo, SensorFlagOverridesTheConfig) {
   write_sequence(stereo_room(3, 0), dir / "seq");
   std::string output;
   // Monocular reads the left images (rgb.txt) alone; three frames of a slow camera give no
-  // two-view parallax, and the summary says so.
-  EXPECT_EQ(testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
-                                   (dir / "seq").string() + " --sensor monocular --dynamic off " +
-                                   "--out " + (dir / "out").string(),
-                               &output),
+  // two-view parallax, and the summary says so. The geometry stage needs depth images: the
+  // `geometry` mode runs nothing, and says so.
+  EXPECT_EQ(testing::run_shell(
+                std::string(PSPSLAM_CLI_PATH) + " run --sequence " + (dir / "seq").string() +
+                    " --sensor monocular --dynamic geometry --out " + (dir / "out").string(),
+                &output),
             0)
       << output;
-  EXPECT_NE(output.find("(camera 'synthetic', monocular, "), std::string::npos) << output;
+  EXPECT_NE(output.find("(camera 'synthetic_stereo', monocular, "), std::string::npos) << output;
   EXPECT_NE(output.find("monocular:    the map never started"), std::string::npos) << output;
+  EXPECT_NE(output.find("dynamic:      off, deterministic (waits for each mask); geometry runs "
+                        "as off (monocular: the geometry stage needs depth images)"),
+            std::string::npos)
+      << output;
+  const std::string stats = testing::read_text(dir / "out" / "stats.json");
+  EXPECT_NE(stats.find("\"sensor\": \"monocular\""), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"mode_requested\": \"geometry\""), std::string::npos) << stats;
   EXPECT_NE(testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
                                    (dir / "seq").string() + " --sensor rgbd --out " +
                                    (dir / "out").string(),

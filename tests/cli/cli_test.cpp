@@ -652,6 +652,14 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   EXPECT_GT(restarted["monocular"]["initialised_at_frame"].get<int>(), started + 11);
   EXPECT_EQ(restarted["monocular"]["tracked_since_initialisation"],
             restarted["monocular"]["frames_since_initialisation"]);
+  // The poses of the first map (another world frame and scale) left trajectory.txt.
+  const int restarted_at = restarted["monocular"]["initialised_at_frame"];
+  const Trajectory after = read_tum_trajectory(dir / "b" / "trajectory.txt");
+  ASSERT_FALSE(after.empty());
+  EXPECT_NEAR(after.front().timestamp, 1000000.0 + restarted_at / 30.0, 1e-3);
+  EXPECT_EQ(after.size(), restarted["monocular"]["tracked_since_initialisation"].get<size_t>());
+  EXPECT_EQ(restarted["lost_frames"].get<size_t>(), 120 - after.size());
+  EXPECT_EQ(count_of(read_text(dir / "b" / "lost_frames.txt"), " restarted\n"), 2u);
 
   // Errors: no intrinsics, a file that is not there, another sensor.
   Result bad =

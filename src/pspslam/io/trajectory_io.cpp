@@ -155,6 +155,15 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& file) : path_(fi
   stream_.flush();
 }
 
+void TrajectoryWriter::clear() {
+  stream_.close();
+  stream_.open(path_, std::ios::out | std::ios::trunc);
+  if (!stream_) throw Error(path_.string() + ": cannot write trajectory file");
+  stream_ << kTrajectoryHeader << '\n';
+  stream_.flush();
+  count_ = 0;
+}
+
 void TrajectoryWriter::write(const StampedPose& pose) {
   // One complete line per write + flush: a kill between two writes leaves only whole lines.
   const std::string line = format_tum_pose(pose) + '\n';

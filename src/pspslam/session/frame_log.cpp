@@ -27,6 +27,7 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
   const TrackResult& result = report.tracking;
   if (result.T_world_camera) {
     trajectory_.write(timestamp, *result.T_world_camera);
+    posed_.emplace_back(index, timestamp);
   } else {
     char line[96];
     std::snprintf(line, sizeof(line), "%zu %.6f %s\n", index, timestamp, to_string(result.state));
@@ -44,6 +45,17 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
                 dyn.mask_age_frames, dyn.geometry_ms, dyn.tested_points, dyn.dynamic_points,
                 dyn.masked_keypoints, dyn.culled_map_points);
   timing_ << row;
+}
+
+void FrameLog::forget_poses() {
+  trajectory_.clear();
+  for (const auto& [index, timestamp] : posed_) {
+    char line[96];
+    std::snprintf(line, sizeof(line), "%zu %.6f restarted\n", index, timestamp);
+    lost_ << line;
+  }
+  lost_ << std::flush;
+  posed_.clear();
 }
 
 }  // namespace pspslam

@@ -3,6 +3,8 @@
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "pspslam/core/types.h"
 #include "pspslam/io/trajectory_io.h"
@@ -13,7 +15,8 @@ namespace pspslam {
 // The per-frame files of a run, written (and flushed) as frames come, so an interrupted run
 // leaves valid files:
 //   trajectory.txt   T_world_camera of every tracked frame (TUM)
-//   lost_frames.txt  frames without a pose (not initialised yet or lost): index timestamp state
+//   lost_frames.txt  frames without a pose (not initialised yet or lost): index timestamp state;
+//                    state `restarted` for frames tracked in a monocular map that was restarted
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
 //                    dynamic-scene stages (mask age, geometry time, masked keypoints)
 class FrameLog {
@@ -27,10 +30,14 @@ class FrameLog {
              const MappingStats& mapping);
 
   size_t poses() const { return trajectory_.count(); }
+  // A monocular map was restarted (TrackResult::restart_due) by the frame just written: the
+  // poses tracked in it leave trajectory.txt and are listed in lost_frames.txt as `restarted`.
+  void forget_poses();
   const std::filesystem::path& trajectory_path() const { return trajectory_.path(); }
 
  private:
   TrajectoryWriter trajectory_;
+  std::vector<std::pair<size_t, Timestamp>> posed_;  // index, time of each line of trajectory_
   std::ofstream lost_;
   std::ofstream timing_;
 };

@@ -54,6 +54,12 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     first_method_after_blackout_ = to_string(result.method);
   }
   if (!result.T_world_camera) ++lost_;
+  if (result.T_world_camera) ++posed_in_this_map_;
+  if (result.restart_due) {
+    // The frames tracked in the map that was restarted leave the trajectory (FrameLog).
+    lost_ += posed_in_this_map_;
+    posed_in_this_map_ = 0;
+  }
   if (result.method == TrackingMethod::kInitialization) {
     initialised_at_ = index;
     tracked_since_initialisation_ = 0;
@@ -64,6 +70,7 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     if (result.T_world_camera) ++tracked_since_initialisation_;
   }
   if (result.restart_due) ++map_restarts_;
+
   if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
   extraction_ms.push_back(report.extraction_ms);
   tracking_ms.push_back(report.tracking_ms);

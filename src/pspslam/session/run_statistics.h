@@ -98,6 +98,7 @@ class RunStatistics {
   size_t tracked_since_initialisation_ = 0;
   size_t processed_since_initialisation_ = 0;
   size_t map_restarts_ = 0;
+  size_t posed_in_this_map_ = 0;
 };
 
 }  // namespace pspslam

@@ -195,6 +195,11 @@ RunOutcome SequenceRunner::run() {
     const MappingStats mapping = system_->mapping_stats();
     const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
     log_.write(i, frame.timestamp, report, local_ba_ms, mapping);
+    if (result.restart_due) {
+      // The new map has its own world frame and scale: the old poses would corrupt the file.
+      log_.forget_poses();
+      estimate_.clear();
+    }
     statistics_.add_frame(i, report, mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
     ba_ms_before = mapping.local_ba_ms_total;
     progress.update(statistics_.processed(), statistics_.realtime_dropped());

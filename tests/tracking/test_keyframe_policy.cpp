@@ -34,6 +34,27 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInterruptMapper);
 }
 
+TEST(KeyFramePolicy, DueKeyFrameEvenWhenTheReferenceCountIsLow) {
+  // The reference keyframe's points seen by >= 3 keyframes are few (sparse keyframes), so the
+  // frame tracks more than 0.9 of them although it has moved on.
+  KeyFrameEvidence e = steady_tracking();
+  e.reference_tracked_points = 110;
+  e.tracked_inliers = 105;
+  e.last_keyframe_frame_id = 69;  // 31 frames ago: due (max_frames_between 30)
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  e.mapper_idle = false;
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
+  e.mapper_idle = true;
+  e.last_keyframe_frame_id = 71;  // 29 frames ago: not yet due
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+  e.last_keyframe_frame_id = 69;
+  KeyFramePolicyOptions orb_slam2;
+  orb_slam2.insert_when_due = false;  // due, but gated on the ratio as in ORB-SLAM2
+  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kSkip);
+  e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+}
+
 TEST(KeyFramePolicy, TrackedRatioToReferenceIsTheThreshold) {
   KeyFrameEvidence e = steady_tracking();
   e.tracked_inliers = 400;  // 0.89 of the reference's 450 points

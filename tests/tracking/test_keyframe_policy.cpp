@@ -41,18 +41,19 @@ TEST(KeyFramePolicy, DueKeyFrameEvenWhenTheReferenceCountIsLow) {
   e.reference_tracked_points = 110;
   e.tracked_inliers = 105;
   e.last_keyframe_frame_id = 69;  // 31 frames ago: due (max_frames_between 30)
-  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
+  KeyFramePolicyOptions when_due;
+  when_due.insert_when_due = true;
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kInsert);
   e.mapper_idle = false;
-  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kInsertInterruptingMapper);
   e.mapper_idle = true;
   e.last_keyframe_frame_id = 71;  // 29 frames ago: not yet due
-  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kSkip);
   e.last_keyframe_frame_id = 69;
-  KeyFramePolicyOptions orb_slam2;
-  orb_slam2.insert_when_due = false;  // due, but gated on the ratio as in ORB-SLAM2
-  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kSkip);
-  e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
+  // The default (ORB-SLAM2): due, but gated on the ratio.
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+  e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kSkip);
 }
 
 TEST(KeyFramePolicy, TrackedRatioToReferenceIsTheThreshold) {

@@ -19,6 +19,7 @@
 #        LOOPS="1:1.5 2:1.5 4:1.75" ...            synthetic loops as SEED:TURNS (default "1:1.5")
 #        OFF_RUNS=1 ...                            runs without loop closing (default RUNS; they
 #                                                  are deterministic: one is enough)
+#        RUN_FLAGS="--due-keyframes" ...           extra `pspslam run` flags for every run
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 build="${1:-$root/build}"
@@ -27,6 +28,7 @@ runs="${RUNS:-3}"
 off_runs="${OFF_RUNS:-$runs}"
 bonn="${BONN:-1}"
 loops="${LOOPS:-1:1.5}"
+read -r -a run_flags <<< "${RUN_FLAGS:-}"
 require_cli "$build"
 mkdir -p "$work"
 python_numpy=/usr/bin/python3  # Debian's, with python3-numpy (bench/loop_error_split.py)
@@ -53,7 +55,8 @@ run_cell() {  # label sequence mode run [extra flags]
   local out="$work/out_${label}_${mode}_$r"
   local load
   load="$(uptime | sed 's/.*load average: //' | cut -d, -f1)"
-  "$cli" run --sequence "$seq" --out "$out" --loop-closing "$mode" "$@" > "$out.log" 2>&1
+  "$cli" run --sequence "$seq" --out "$out" --loop-closing "$mode" "$@" ${run_flags[@]+"${run_flags[@]}"} \
+    > "$out.log" 2>&1
   local stats="$out/stats.json" split="nan,nan,nan"
   [[ "$label" == bonn_crowd_dev ]] || split="$(split_columns "$seq" "$out")"
   echo "$label,$mode,$r,$(json_value "$stats" ate_refined.rmse),$(json_value "$stats" ate.rmse),$(json_value "$stats" loops.closed),$(json_value "$stats" loops.global_ba_applied),$(json_value "$stats" seconds),$load,$split" >> "$results"

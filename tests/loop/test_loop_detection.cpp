@@ -219,7 +219,7 @@ TEST(LoopDetection, SyntheticLoopIsFoundOnRevisitAndCorrected) {
 // Loop closing's own share of a run's accuracy (issue #15 item 5): after the correction and the
 // global BA, every keyframe of the loop must be back near the truth, including the far side of
 // the first turn, which only the essential graph and the global BA reach. On the 900-frame
-// synthetic loop of bench/run_loop.sh the final keyframes are at 2.4-3.3 mm against 11-17 mm
+// synthetic loop of bench/run_loop.sh the final keyframes are at 2.4-3.4 mm against 11-17 mm
 // without loop closing (docs/benchmarks.md); here the drift is larger (up to 0.18 m).
 TEST(LoopDetection, KeyframesAreBackOnTheTruthAfterCorrectionAndGlobalBa) {
   const auto place = PlaceRecognition::load(default_vocabulary_path());

@@ -132,6 +132,7 @@ struct RunFlags {
   bool realtime = false;
   int mask_margin = 5;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
+  bool due_keyframes = false;
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
   std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
@@ -182,6 +183,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   system.local_mapping = !flags.no_local_mapping;
   system.synchronous_local_mapping = !flags.realtime;
   system.tracker.keyframes.tracked_ratio_to_reference = flags.keyframe_ratio;
+  system.tracker.keyframes.insert_when_due = flags.due_keyframes;
   if (flags.motion_prior.size() == 2) {
     system.tracker.motion_prior_sigma_translation = flags.motion_prior[0] * 1e-3;
     system.tracker.motion_prior_sigma_rotation = flags.motion_prior[1] * std::numbers::pi / 180.0;
@@ -324,6 +326,10 @@ Command add_run_command(CLI::App& root) {
                   "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)")
       ->check(in_range(0.01, 1.0))
       ->capture_default_str();
+  app->add_flag("--due-keyframes", flags->due_keyframes,
+                "also make a keyframe once a second has passed since the last one, whatever "
+                "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "
+                "off by default: mixed on the accuracy panel, docs/benchmarks.md #15 item 5)");
   app->add_option("--motion-prior", flags->motion_prior,
                   "MM DEG: optimise each frame tracked with the motion model with its "
                   "constant-velocity prediction as a prior of these σs (translation mm, rotation "

@@ -34,6 +34,28 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInterruptMapper);
 }
 
+TEST(KeyFramePolicy, DueKeyFrameEvenWhenTheReferenceCountIsLow) {
+  // The reference keyframe's points seen by >= 3 keyframes are few (sparse keyframes), so the
+  // frame tracks more than 0.9 of them although it has moved on.
+  KeyFrameEvidence e = steady_tracking();
+  e.reference_tracked_points = 110;
+  e.tracked_inliers = 105;
+  e.last_keyframe_frame_id = 69;  // 31 frames ago: due (max_frames_between 30)
+  KeyFramePolicyOptions when_due;
+  when_due.insert_when_due = true;
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kInsert);
+  e.mapper_idle = false;
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kInsertInterruptingMapper);
+  e.mapper_idle = true;
+  e.last_keyframe_frame_id = 71;  // 29 frames ago: not yet due
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kSkip);
+  e.last_keyframe_frame_id = 69;
+  // The default (ORB-SLAM2): due, but gated on the ratio.
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);
+  e.tracked_inliers = 15;  // too few inliers to make a reliable keyframe
+  EXPECT_EQ(decide_keyframe(e, when_due), KeyFrameDecision::kSkip);
+}
+
 TEST(KeyFramePolicy, TrackedRatioToReferenceIsTheThreshold) {
   KeyFrameEvidence e = steady_tracking();
   e.tracked_inliers = 400;  // 0.89 of the reference's 450 points

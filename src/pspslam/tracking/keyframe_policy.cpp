@@ -21,7 +21,8 @@ KeyFrameDecision decide_keyframe(const KeyFrameEvidence& e, const KeyFramePolicy
   const bool fewer_than_reference =
       (e.tracked_inliers < e.reference_tracked_points * ratio_threshold || need_close) &&
       e.tracked_inliers > 15;
-  if (!((due || idle_and_allowed || weak) && fewer_than_reference)) {
+  const bool due_anyway = o.insert_when_due && due && e.tracked_inliers > 15;
+  if (!due_anyway && !((due || idle_and_allowed || weak) && fewer_than_reference)) {
     return KeyFrameDecision::kSkip;
   }
   if (e.mapper_idle) return KeyFrameDecision::kInsert;

@@ -180,8 +180,8 @@ Options parse(int* argc, char** argv) {
   if (o.models.empty()) {
     const fs::path src = pspslam::source_dir() / "models";
     o.models = {src / "pspnet" / "pspnet.yaml",
-                src / "pspnet" / "pspnet_384x288.yaml",
-                src / "pspnet" / "pspnet_192x144.yaml",
+                src / "pspnet" / "pspnet_288x192.yaml",
+                src / "pspnet" / "pspnet_480x384.yaml",
                 src / "teachers" / "deeplabv3_mnv2_pascal.yaml",
                 src / "teachers" / "deeplabv3_mnv2_dm05_pascal.yaml",
                 src / "teachers" / "espnetv2_s2.0_pascal_384x384.yaml"};

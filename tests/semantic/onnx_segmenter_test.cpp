@@ -158,11 +158,11 @@ TEST(OnnxSegmenter, PersonIoUOnValidationPhotos) {
   const auto ids = validation_ids();
   ASSERT_GE(ids.size(), 40u);
   double sum = 0;
-  const int n = 12;
-  for (int i = 0; i < n; ++i) sum += person_iou(segmenter, shared, ids[static_cast<size_t>(i)]);
-  // The shipped model scores 0.888 on these 12 photos (0.817 on all 46, MODEL_CARD.md); the
-  // margin only absorbs arg-max ties, a broken pre-processing drops far below it.
-  EXPECT_GE(sum / n, 0.86);
+  for (int id : ids) sum += person_iou(segmenter, shared, id);
+  // Issue #18's target is >= 0.86 on the whole validation split; the shipped model scores
+  // 0.8712 there (MODEL_CARD.md, bench_segmentation). The tolerance only absorbs arg-max ties;
+  // a pre-processing change (resize, normalisation, channel order) moves it by far more.
+  EXPECT_NEAR(sum / static_cast<double>(ids.size()), 0.8712, 0.002);
 }
 
 TEST(OnnxSegmenter, TeachersRunThroughTheSameClass) {

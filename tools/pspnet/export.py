@@ -19,7 +19,7 @@ import onnx
 import torch
 
 import common
-from model import PSPNet
+from model import ARCHITECTURES, PSPNet
 from onnx_fix import remove_zero_pads, replace_identity_on_initializers
 
 
@@ -101,12 +101,15 @@ def main():
     cv2.setNumThreads(2)
     state = torch.load(args.checkpoint, map_location="cpu")
     hw = (args.height, args.width)
+    arch = ARCHITECTURES[state["arch"]]
     model = PSPNet(hw, state["width_multiplier"], state["branch_channels"],
-                   state["head_channels"], last_dilation=state.get("last_dilation", 4))
+                   state["head_channels"], last_dilation=state["last_dilation"], **arch)
     model.load_state_dict(state["model"])
     model.eval()
     # Same function, faster graph for OpenCV 4.6 where the phase rows are wide enough.
-    model.backbone.phase_layout = model.backbone.phase_layout_pays((args.height // 8, args.width // 8))
+    stride = arch["output_stride"]
+    model.backbone.phase_layout = model.backbone.phase_layout_pays(
+        (args.height // stride, args.width // stride))
     print(f"space-to-batch layout for the dilated stages: {model.backbone.phase_layout}")
 
     out_dir = Path(args.out_dir)

@@ -27,7 +27,7 @@ import torch.nn.functional as F
 from onnx import numpy_helper
 
 import common
-from model import PSPNet, PERSON
+from model import ARCHITECTURES, PSPNet, PERSON
 
 IGNORE = 255
 
@@ -166,9 +166,12 @@ def main():
                         help="DeepLab v3 MobileNetV2 ONNX to initialise the backbone from")
     parser.add_argument("--width-multiplier", default="0.5", choices=["0.5", "1.0"],
                         help="MobileNetV2 width (must match --init)")
-    parser.add_argument("--last-dilation", type=int, default=2, choices=[2, 4],
-                        help="dilation of the 160/320 stages (2: every dilated stage has rate 2, "
-                             "which the export runs undilated in space-to-batch layout)")
+    parser.add_argument("--arch", default="os16_decoder", choices=sorted(ARCHITECTURES),
+                        help="architecture (model.ARCHITECTURES; MODEL_CARD.md compares them)")
+    parser.add_argument("--last-dilation", type=int, default=2, choices=[1, 2, 4],
+                        help="dilation of the 160/320 stages (model.stage_plan; with output "
+                             "stride 8, 2 lets the export run every dilated stage undilated in "
+                             "space-to-batch layout)")
     parser.add_argument("--branch-channels", type=int, default=32, help="PPM branch channels")
     parser.add_argument("--head-channels", type=int, default=64, help="3x3 head conv channels")
     parser.add_argument("--input-width", type=int, default=384, help="training/shipping width")
@@ -221,7 +224,8 @@ def main():
     kinds = list(cache["kinds"])
     split = common.load_split()
     model = PSPNet(hw, args.width_multiplier, branch_channels=args.branch_channels,
-                   head_channels=args.head_channels, last_dilation=args.last_dilation)
+                   head_channels=args.head_channels, last_dilation=args.last_dilation,
+                   **ARCHITECTURES[args.arch])
     n_init = load_backbone_from_onnx(model, args.init)
     model.to(device)
     backbone, head = model.param_groups()
@@ -325,7 +329,7 @@ def main():
     state = {"model": {k: v.cpu() for k, v in model.state_dict().items()}, "epoch": epoch,
              "val_iou": iou, "width_multiplier": args.width_multiplier,
              "branch_channels": args.branch_channels, "head_channels": args.head_channels,
-             "last_dilation": args.last_dilation, "input_hw": hw, "args": vars(args)}
+             "last_dilation": args.last_dilation, "arch": args.arch, "input_hw": hw, "args": vars(args)}
     torch.save(state, args.out)  # the last epoch is the shipped one
     say(f"# finished {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime())}; shipped the last "
         f"epoch (val IoU {iou:.4f}); best validated epoch IoU {best:.4f} (not used for "

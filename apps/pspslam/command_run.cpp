@@ -16,6 +16,7 @@
 //                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)
 #include <spdlog/spdlog.h>
+#include <opencv2/core/utility.hpp>
 
 #include <chrono>
 #include <filesystem>
@@ -52,6 +53,9 @@ constexpr int kInterruptedExit = 130;
 constexpr int kNeverStartedExit = 3;
 // --camera: the camera stopped delivering (unplugged); the outputs hold every frame so far.
 constexpr int kCameraLostExit = 4;
+// Nice increment of the background threads in live runs (--background-nice; issue #18 item 1:
+// measured in docs/benchmarks.md "Real time on two cores").
+constexpr int kLiveBackgroundNice = 10;
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
 // with a warning that says which model is missing and how to get it; an explicitly requested
@@ -130,6 +134,8 @@ struct RunFlags {
   std::string dynamic = "auto";
   std::string model;  // empty: the shipped model
   bool realtime = false;
+  int background_nice = -1;  // -1: kLiveBackgroundNice for live runs, else 0
+  int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
@@ -182,6 +188,15 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
   system.local_mapping = !flags.no_local_mapping;
   system.synchronous_local_mapping = !flags.realtime;
+  const bool live = flags.realtime || !flags.camera.empty();
+  system.background_thread_nice =
+      flags.background_nice >= 0 ? flags.background_nice : (live ? kLiveBackgroundNice : 0);
+  // OpenCV's pool is process-wide: with one thread the network runs on the (lowered) semantic
+  // thread alone instead of borrowing workers that compete with tracking at full priority.
+  if (flags.opencv_threads >= 0)
+    cv::setNumThreads(flags.opencv_threads);
+  else if (live)
+    cv::setNumThreads(1);
   system.tracker.keyframes.tracked_ratio_to_reference = flags.keyframe_ratio;
   system.tracker.keyframes.insert_when_due = flags.due_keyframes;
   if (flags.motion_prior.size() == 2) {
@@ -317,6 +332,18 @@ Command add_run_command(CLI::App& root) {
                 "segmentation or local mapping: use the newest mask, warped into the frame "
                 "(default: deterministic, each frame waits for its mask and for local mapping "
                 "to finish the previous keyframe)");
+  app->add_option("--background-nice", flags->background_nice,
+                  "scheduling priority given up by the semantic, local mapping and loop closing "
+                  "threads (nice increment, 0-19) so that tracking gets a core when a frame "
+                  "arrives (default: " +
+                      std::to_string(kLiveBackgroundNice) +
+                      " with --realtime or --camera, 0 otherwise)")
+      ->check(in_range(0, 19));
+  app->add_option("--opencv-threads", flags->opencv_threads,
+                  "OpenCV worker threads (network, image operations; 0 = OpenCV's default, all "
+                  "cores). Default: 1 with --realtime or --camera, so that the network runs on "
+                  "the lowered semantic thread alone; OpenCV's default otherwise")
+      ->check(in_range(0, 256));
   app->add_option("--mask-margin", flags->mask_margin,
                   "dilation of the semantic dynamic mask (pixels)")
       ->check(in_range(0, 100))

@@ -6,8 +6,10 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <tuple>
 
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/io/point_cloud_ply.h"
@@ -546,6 +548,8 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
 
 // stats.json `latency`: with --realtime every processed frame has its arrival-to-pose time
 // (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
+// `scheduling`: a real-time run lowers the background threads (nice 10) and gives OpenCV one
+// thread; a deterministic run changes neither; --background-nice / --opencv-threads override.
 TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   const auto dir = testing::make_temp_dir("cli_latency");
   const Result synth =
@@ -557,21 +561,42 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
     EXPECT_EQ(r.status, 0) << r.output;
     std::ifstream in(dir / name / "stats.json");
     const nlohmann::json stats = nlohmann::json::parse(in);
-    return std::pair{stats["latency"], stats["frames"].get<int>()};
+    return std::tuple{stats["latency"], stats["frames"].get<int>(), stats["scheduling"]};
   };
-  const auto [realtime, processed] = latency("realtime", "--realtime");
+  // timing.csv's last column: each frame's arrival to pose, empty without an arrival.
+  const auto arrival_column = [&](const std::string& name) {
+    std::ifstream in(dir / name / "timing.csv");
+    std::string header;
+    std::getline(in, header);
+    EXPECT_TRUE(header.ends_with(",arrival_to_pose_ms")) << header;
+    std::vector<std::string> values;
+    for (std::string row; std::getline(in, row);) values.push_back(row.substr(row.rfind(',') + 1));
+    return values;
+  };
+  const auto [realtime, processed, live_scheduling] = latency("realtime", "--realtime");
+  const std::vector<std::string> live_arrivals = arrival_column("realtime");
+  ASSERT_EQ(live_arrivals.size(), static_cast<size_t>(processed));
+  for (const std::string& value : live_arrivals) EXPECT_GT(std::stod(value), 0.0);
+  EXPECT_EQ(live_scheduling["background_thread_nice"].get<int>(), 10);
+  EXPECT_EQ(live_scheduling["opencv_threads"].get<int>(), 1);
   EXPECT_EQ(realtime["arrival_to_pose_ms"]["count"].get<int>(), processed);
   const double median = realtime["arrival_to_pose_ms"]["median"].get<double>();
   EXPECT_GT(median, 0.0);
   EXPECT_GE(realtime["arrival_to_pose_ms"]["p99"].get<double>(), median);
   EXPECT_GE(realtime["arrival_to_pose_ms"]["max"].get<double>(),
             realtime["arrival_to_pose_ms"]["p99"].get<double>());
-  const auto [deterministic, frames] = latency("deterministic", "");
+  const auto [deterministic, frames, scheduling] = latency("deterministic", "");
   EXPECT_EQ(frames, 30);
   EXPECT_EQ(deterministic["arrival_to_pose_ms"]["count"].get<int>(), 0);
+  EXPECT_EQ(arrival_column("deterministic"), std::vector<std::string>(30, ""));
+  EXPECT_EQ(scheduling["background_thread_nice"].get<int>(), 0);
+  EXPECT_EQ(scheduling["opencv_threads"].get<int>(), cv::getNumThreads());
+  const auto [chosen_latency, chosen_frames, chosen] =
+      latency("chosen", "--realtime --background-nice 3 --opencv-threads 2");
+  EXPECT_EQ(chosen["background_thread_nice"].get<int>(), 3);
+  EXPECT_EQ(chosen["opencv_threads"].get<int>(), 2);
 }
 
-// A mistyped config key is named, with the key it probably meant.
 // --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own
 // encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
 // 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
@@ -680,6 +705,7 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
       << bad.output;
 }
 
+// A mistyped config key is named, with the key it probably meant.
 TEST(CliRun, MistypedConfigKeyIsNamedWithASuggestion) {
   const auto dir = make_sequence("cli_typo", false);
   std::ofstream(dir / "typo.yaml")

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "pspslam/core/error.h"
+#include "pspslam/core/thread_priority.h"
 #include "pspslam/semantic/semantic_thread.h"
 
 namespace pspslam {
@@ -250,6 +251,31 @@ TEST(SemanticThread, AFailingFrameIsReportedAndTheThreadGoesOn) {
   EXPECT_EQ(stats.failed, 1);
   EXPECT_EQ(stats.processed, 1);
   EXPECT_EQ(stats.last_error, "frame 2 is broken");
+}
+
+// Records the nice value of the thread that segments.
+class NiceRecordingSegmenter : public FakeSegmenter {
+ public:
+  NiceRecordingSegmenter(std::shared_ptr<Control> control, std::atomic<int>& nice)
+      : FakeSegmenter(std::move(control), 0ms), nice_(nice) {}
+  LabelMap segment(const cv::Mat& bgr) override {
+    nice_ = this_thread_nice();
+    return FakeSegmenter::segment(bgr);
+  }
+
+ private:
+  std::atomic<int>& nice_;
+};
+
+TEST(SemanticThread, SegmentsAtTheRequestedLowerPriority) {
+  auto control = std::make_shared<FakeSegmenter::Control>();
+  std::atomic<int> nice{-100};
+  SemanticParams params;
+  params.thread_nice = 4;
+  SemanticThread thread(std::make_unique<NiceRecordingSegmenter>(control, nice), params);
+  thread.submit(1, 1.0, frame_image(1));
+  ASSERT_NE(thread.wait_for(1, 5s), nullptr);
+  EXPECT_EQ(nice.load(), std::min(19, this_thread_nice() + 4));
 }
 
 TEST(DynamicMask, MarksDynamicLabelsAndGrowsByTheMargin) {

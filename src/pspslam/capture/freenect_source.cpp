@@ -15,9 +15,9 @@
 #include "pspslam/capture/camera_spec.h"
 #include "pspslam/capture/device_clock.h"
 #include "pspslam/capture/kinect_depth.h"
-#include "pspslam/capture/latest_queue.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
+#include "pspslam/core/latest_queue.h"
 
 namespace pspslam {
 namespace {

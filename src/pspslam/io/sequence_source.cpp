@@ -1,7 +1,7 @@
 #include "pspslam/io/sequence_source.h"
 
 #include <algorithm>
-#include <thread>
+#include <exception>
 #include <utility>
 
 namespace pspslam {
@@ -10,34 +10,78 @@ SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool pace
     : setup_(std::move(setup)),
       frames_(max_frames == 0 ? setup_.sequence.size()
                               : std::min(setup_.sequence.size(), max_frames)),
-      paced_(paced) {}
+      paced_(paced) {
+  if (paced_) reader_ = std::jthread([this](const std::stop_token& stop) { read_paced(stop); });
+}
+
+SequenceSource::~SequenceSource() {
+  reader_.request_stop();
+  delivered_.close("source closed");
+  // jthread joins; the reader's waits end on the stop token.
+}
+
+void SequenceSource::read_paced(const std::stop_token& stop) {
+  const RgbdSequence& sequence = setup_.sequence;
+  Clock::time_point start;
+  {
+    std::unique_lock lock(start_mutex_);
+    if (!start_cv_.wait(lock, stop, [this] { return start_.has_value(); })) return;
+    start = *start_;
+  }
+  const Timestamp t0 = frames_ > 0 ? sequence.timestamp(0) : 0.0;
+  try {
+    const auto due_time = [&](size_t index) {
+      return start + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(sequence.timestamp(index) - t0));
+    };
+    for (size_t index = 0; index < frames_ && !stop.stop_requested(); ++index) {
+      // A camera does not queue what it could not deliver: when the reader itself is late
+      // (decoding competes for the cores), it goes on with the newest frame already due.
+      const auto now = Clock::now();
+      size_t newest = index;
+      while (newest + 1 < frames_ && due_time(newest + 1) <= now) ++newest;
+      skipped_ += newest - index;
+      index = newest;
+      // Decoded ahead, delivered when due; one that is late when decoded is delivered at once,
+      // and that lateness counts in its latency (its arrival stays the due time).
+      RgbdFrame frame = sequence.load(index);
+      const auto due = due_time(index);
+      {
+        std::unique_lock lock(start_mutex_);
+        start_cv_.wait_until(lock, stop, due, [] { return false; });
+      }
+      if (stop.stop_requested()) break;
+      frame.arrival = due;
+      delivered_.push(std::move(frame));
+    }
+  } catch (...) {
+    // An unreadable file ends the feed; next() rethrows it on the caller's thread, which
+    // reports it as the deterministic reading would.
+    std::lock_guard lock(start_mutex_);
+    failure_ = std::current_exception();
+  }
+  delivered_.close("end of sequence");
+}
 
 std::optional<RgbdFrame> SequenceSource::next() {
-  if (next_index_ >= frames_) return std::nullopt;
-  const RgbdSequence& sequence = setup_.sequence;
-  if (paced_) {
-    // A live camera does not wait: skip to the newest frame whose time has come.
-    const auto now = std::chrono::steady_clock::now();
-    if (!start_) start_ = now;
-    const double elapsed = std::chrono::duration<double>(now - *start_).count();
-    const Timestamp t0 = sequence.timestamp(0);
-    size_t newest = next_index_;
-    while (newest + 1 < frames_ && sequence.timestamp(newest + 1) - t0 <= elapsed) ++newest;
-    dropped_ += newest - next_index_;
-    next_index_ = newest;
-    const double due = sequence.timestamp(newest) - t0;
-    const double wait = due - elapsed;
-    if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
-    // The frame arrived when it was due, not when the busy caller came for it: the time it
-    // waited here is part of its latency, as it is for a camera's buffered frame.
-    std::optional<RgbdFrame> frame = sequence.load(next_index_++);
-    if (frame) {
-      frame->arrival = *start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                     std::chrono::duration<double>(due));
-    }
-    return frame;
+  if (!paced_) {
+    if (next_index_ >= frames_) return std::nullopt;
+    return setup_.sequence.load(next_index_++);
   }
-  return sequence.load(next_index_++);
+  {
+    std::lock_guard lock(start_mutex_);
+    if (!start_) start_ = Clock::now();
+  }
+  start_cv_.notify_all();
+  for (;;) {
+    if (std::optional<RgbdFrame> frame = delivered_.pop(std::chrono::milliseconds(1000)))
+      return frame;
+    if (delivered_.closed()) {
+      std::lock_guard lock(start_mutex_);
+      if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
+      return std::nullopt;
+    }
+  }
 }
 
 }  // namespace pspslam

@@ -1,23 +1,39 @@
 #pragma once
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstddef>
+#include <exception>
+#include <mutex>
 #include <optional>
+#include <stop_token>
 #include <string>
+#include <thread>
 
+#include "pspslam/core/latest_queue.h"
 #include "pspslam/io/frame_source.h"
 #include "pspslam/io/sequence_setup.h"
 
 namespace pspslam {
 
-// A recorded sequence as a FrameSource. Deterministic by default: every frame, in order.
-// `paced` feeds it like a live camera (`pspslam run --realtime`): frames are due at their
-// timestamps from the first next() on, and next() skips to the newest frame whose time has come
-// (the skipped ones count as dropped), sleeping when the caller is early.
+// A recorded sequence as a FrameSource. Deterministic by default: every frame, in order, read
+// by next() itself.
+// `paced` feeds it like a live camera (`pspslam run --realtime`): a reader thread decodes each
+// frame ahead of its time and delivers it when it is due (its timestamp after the first one,
+// counted from the first next()), into a newest-wins slot; next() takes the newest delivered
+// frame and waits when the caller is early. A frame the caller did not take before the next one
+// was delivered counts as dropped, as does one the reader skipped because it was late itself.
+// A frame's `arrival` is its due time: what a camera delivers decoded at that moment, so the
+// decoding of the recording's image files, which a camera does not have, is not part of the
+// latency measured from it (issue #18).
 class SequenceSource final : public FrameSource {
  public:
   // `max_frames` 0 = all.
   SequenceSource(SequenceSetup setup, size_t max_frames, bool paced);
+  ~SequenceSource() override;  // stops and joins the reader
+  SequenceSource(const SequenceSource&) = delete;
+  SequenceSource& operator=(const SequenceSource&) = delete;
 
   std::optional<RgbdFrame> next() override;
   std::optional<size_t> frame_count() const override { return frames_; }
@@ -28,19 +44,27 @@ class SequenceSource final : public FrameSource {
   }
   FrameSourceStats stats() const override {
     FrameSourceStats stats;
-    stats.dropped = dropped_;
+    stats.dropped = delivered_.dropped() + skipped_.load();
     return stats;
   }
 
   const SequenceSetup& setup() const { return setup_; }
 
  private:
+  using Clock = std::chrono::steady_clock;
+  void read_paced(const std::stop_token& stop);
+
   SequenceSetup setup_;
   size_t frames_ = 0;
   bool paced_ = false;
-  size_t next_index_ = 0;
-  size_t dropped_ = 0;
-  std::optional<std::chrono::steady_clock::time_point> start_;
+  size_t next_index_ = 0;  // deterministic reading
+  LatestQueue<RgbdFrame> delivered_{1};
+  std::atomic<size_t> skipped_{0};  // frames the reader never decoded: it was late for them
+  std::mutex start_mutex_;
+  std::condition_variable_any start_cv_;
+  std::optional<Clock::time_point> start_;  // set by the first next(); under start_mutex_
+  std::exception_ptr failure_;              // the reader's error, for next(); under start_mutex_
+  std::jthread reader_;                     // last: starts after everything above (paced only)
 };
 
 }  // namespace pspslam

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "pspslam/core/clock.h"
+#include "pspslam/core/thread_priority.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/mapping/local_mapping.h"
@@ -46,6 +47,7 @@ LoopClosingStats LoopClosing::stats() const {
 }
 
 void LoopClosing::run(const std::stop_token& stop) {
+  lower_this_thread_priority(options_.thread_nice);
   while (!stop.stop_requested()) {
     std::shared_ptr<KeyFrame> keyframe;
     {

@@ -41,6 +41,9 @@ struct LoopClosingOptions {
   LoopCorrectionOptions correction;
   bool global_bundle_adjustment = true;
   GlobalBaOptions global_ba;
+  // Nice increment of the loop closing thread; the global BA threads it starts inherit it
+  // (core/thread_priority.h; real-time runs).
+  int thread_nice = 0;
 };
 
 struct LoopClosingStats {

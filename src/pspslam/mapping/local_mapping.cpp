@@ -1,5 +1,6 @@
 #include "pspslam/mapping/local_mapping.h"
 
+#include "pspslam/core/thread_priority.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 
@@ -7,8 +8,11 @@ namespace pspslam {
 
 LocalMapping::LocalMapping(std::shared_ptr<Map> map, LocalMappingOptions options,
                            std::shared_ptr<PlaceRecognition> place)
-    : mapper_(std::move(map), std::move(options), std::move(place)),
-      thread_([this](const std::stop_token& stop) { run(stop); }) {}
+    : mapper_(std::move(map), options, std::move(place)),
+      thread_([this, nice = options.thread_nice](const std::stop_token& stop) {
+        lower_this_thread_priority(nice);
+        run(stop);
+      }) {}
 
 LocalMapping::~LocalMapping() {
   thread_.request_stop();

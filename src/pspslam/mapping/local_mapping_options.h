@@ -33,6 +33,8 @@ struct LocalMappingOptions {
   bool redundancy_needs_depth = true;
   bool cull_keyframes = true;
   BaOptions bundle_adjustment;
+  // Nice increment of the local mapping thread (core/thread_priority.h; real-time runs).
+  int thread_nice = 0;
 
   // Defaults, with the sensor's close-depth threshold from the config.
   static LocalMappingOptions from_config(const SystemConfig& config) {

@@ -17,6 +17,8 @@ struct SemanticParams {
   int mask_dilation_px = 5;  // grow the dynamic mask by this margin (pixels)
   int queue_size = 1;        // pending frames kept; older ones are dropped when full
   int history = 64;          // published results kept for look-up by timestamp
+  // Nice increment of the semantic thread (not a YAML key: real-time runs set it).
+  int thread_nice = 0;
 
   // Reads the keys of `section`, calls section.finish() (unknown keys are errors) and
   // validates the values (pspslam::Error naming the key).

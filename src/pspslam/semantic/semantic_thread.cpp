@@ -5,6 +5,7 @@
 
 #include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/thread_priority.h"
 
 namespace pspslam {
 SemanticThread::SemanticThread(std::unique_ptr<Segmenter> segmenter, const SemanticParams& params)
@@ -17,7 +18,10 @@ SemanticThread::SemanticThread(std::unique_ptr<Segmenter> segmenter, const Seman
                      ? segmenter_->default_dynamic_classes()
                      : class_ids(segmenter_->class_names(), params.dynamic_classes,
                                  "semantic.dynamic_classes");
-  worker_ = std::thread([this] { run(); });
+  worker_ = std::thread([this, nice = params.thread_nice] {
+    lower_this_thread_priority(nice);
+    run();
+  });
 }
 
 SemanticThread::~SemanticThread() { stop(); }

@@ -17,13 +17,16 @@ FrameLog::FrameLog(const std::filesystem::path& folder)
       lost_(open_output(folder / "lost_frames.txt")),
       timing_(open_output(folder / "timing.csv")) {
   lost_ << "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
-  timing_ << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
-             "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_"
-             "ms,mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points\n";
+  timing_
+      << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
+         "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_"
+         "ms,mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points,arrival_to_pose_"
+         "ms\n";
 }
 
 void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& report,
-                     double local_ba_ms, const MappingStats& mapping) {
+                     double local_ba_ms, const MappingStats& mapping,
+                     std::optional<double> arrival_to_pose_ms) {
   const TrackResult& result = report.tracking;
   if (result.T_world_camera) {
     trajectory_.write(timestamp, *result.T_world_camera);
@@ -37,7 +40,7 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
   char row[384];
   std::snprintf(row, sizeof(row),
                 "%zu,%.6f,%s,%s,%d,%d,%d,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%d,%d,%d,"
-                "%d\n",
+                "%d,",
                 index, timestamp, to_string(result.state), to_string(result.method),
                 result.num_keypoints, result.num_inliers, result.keyframe_inserted ? 1 : 0,
                 report.extraction_ms, report.tracking_ms, local_ba_ms, mapping.queued_keyframes,
@@ -45,6 +48,12 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
                 dyn.mask_age_frames, dyn.geometry_ms, dyn.tested_points, dyn.dynamic_points,
                 dyn.masked_keypoints, dyn.culled_map_points);
   timing_ << row;
+  // Empty where a frame has no arrival time (deterministic runs).
+  if (arrival_to_pose_ms) {
+    std::snprintf(row, sizeof(row), "%.3f", *arrival_to_pose_ms);
+    timing_ << row;
+  }
+  timing_ << '\n';
 }
 
 void FrameLog::forget_poses() {

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -18,16 +19,18 @@ namespace pspslam {
 //   lost_frames.txt  frames without a pose (not initialised yet or lost): index timestamp state;
 //                    state `restarted` for frames tracked in a monocular map that was restarted
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
-//                    dynamic-scene stages (mask age, geometry time, masked keypoints)
+//                    dynamic-scene stages (mask age, geometry time, masked keypoints) and,
+//                    for frames that arrived live (--realtime, a camera), arrival to pose
 class FrameLog {
  public:
   // Creates the three files in `folder` (which must exist); throws pspslam::Error naming a file
   // that cannot be written.
   explicit FrameLog(const std::filesystem::path& folder);
 
-  // `local_ba_ms`: local BA time finished since the previous frame; `mapping` as of now.
+  // `local_ba_ms`: local BA time finished since the previous frame; `mapping` as of now;
+  // `arrival_to_pose_ms`: from the frame's arrival to its pose, when it had an arrival.
   void write(size_t index, Timestamp timestamp, const FrameReport& report, double local_ba_ms,
-             const MappingStats& mapping);
+             const MappingStats& mapping, std::optional<double> arrival_to_pose_ms);
 
   size_t poses() const { return trajectory_.count(); }
   // A monocular map was restarted (TrackResult::restart_due) by the frame just written: the

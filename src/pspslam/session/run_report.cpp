@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
 #include <optional>
 #include <tuple>
 #include <utility>
@@ -241,6 +242,9 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   const LatencySummary arrival_to_pose = summarize_latency(stats.arrival_to_pose_ms);
   json["latency"] = {{"arrival_to_pose_ms", to_json(arrival_to_pose)},
                      {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
+  // How the threads shared the cores (issue #18 item 1's levers), to read beside the latency.
+  json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
+                        {"opencv_threads", cv::getNumThreads()}};
   json["map"] = {{"keyframes", mapping.keyframes_in_map}, {"map_points", mapping.map_points}};
   json["loops"] = {{"enabled", system.place.loop_closing},
                    {"closed", mapping.loops_closed},

@@ -168,11 +168,12 @@ RunOutcome SequenceRunner::run() {
                                          overlays || detail.masked_keypoints);
     }
     const FrameReport report = system_->process(frame);
+    std::optional<double> arrival_to_pose_ms;
     if (frame.arrival) {
-      statistics_.arrival_to_pose_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                    *frame.arrival)
-              .count());
+      arrival_to_pose_ms = std::chrono::duration<double, std::milli>(
+                               std::chrono::steady_clock::now() - *frame.arrival)
+                               .count();
+      statistics_.arrival_to_pose_ms.push_back(*arrival_to_pose_ms);
     }
     const TrackResult& result = report.tracking;
     spdlog::debug(
@@ -194,7 +195,7 @@ RunOutcome SequenceRunner::run() {
     if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
     const MappingStats mapping = system_->mapping_stats();
     const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
-    log_.write(i, frame.timestamp, report, local_ba_ms, mapping);
+    log_.write(i, frame.timestamp, report, local_ba_ms, mapping, arrival_to_pose_ms);
     if (result.restart_due) {
       // The new map has its own world frame and scale: the old poses would corrupt the file.
       log_.forget_poses();

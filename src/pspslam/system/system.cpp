@@ -202,6 +202,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
       mapping_options.bundle_adjustment.depth_noise = {.enabled = true,
                                                        .scale = config.camera.depth_noise_scale};
+    mapping_options.thread_nice = options.background_thread_nice;
     frame_builder_->adapt(mapping_options);
     mapping = std::make_unique<LocalMapping>(map_, mapping_options, place_);
   }
@@ -228,6 +229,7 @@ System::System(const SystemConfig& config, SystemOptions options)
   record_keypoint_fates_ = options.record_keypoint_fates;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     LoopClosingOptions loop_options;
+    loop_options.thread_nice = options.background_thread_nice;
     // The global BA weighs depth as local BA does; otherwise it moves weakly connected keyframes
     // away from where local BA's depth constraint held them (#15 item 5).
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
@@ -246,6 +248,7 @@ System::System(const SystemConfig& config, SystemOptions options)
         });
   }
   if (options.dynamic.mode != DynamicMode::off) {
+    options.dynamic.semantic.thread_nice = options.background_thread_nice;
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
     if (options.localization_only) dynamic_->use_loaded_map_only();
   }

@@ -53,6 +53,11 @@ struct SystemOptions {
   // is tracked against, and whether a keyframe is accepted, depend on how fast this machine is
   // right now (a fast, unpaced run outruns local BA). A live camera wants false.
   bool synchronous_local_mapping = false;
+  // Nice increment of the semantic, local mapping and loop closing threads (and of the global
+  // BA threads loop closing starts). A live run (--realtime, a camera) sets it so that the
+  // caller thread, which must track each frame before the next one arrives, gets a core when
+  // it needs one and the background work takes what is left (issue #18 item 1).
+  int background_thread_nice = 0;
   DynamicOptions dynamic;
   PlaceOptions place;
   // Map file to start from (`pspslam run --load-map`, persistence/map_file.h); empty: start a

@@ -1,0 +1,38 @@
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "pspslam/core/thread_priority.h"
+
+namespace pspslam {
+namespace {
+
+TEST(ThreadPriority, LowersOnlyTheCallingThread) {
+  const int caller_before = this_thread_nice();
+  int worker_before = 0;
+  int worker_after = 0;
+  bool lowered = false;
+  std::thread worker([&] {
+    worker_before = this_thread_nice();
+    lowered = lower_this_thread_priority(3);
+    worker_after = this_thread_nice();
+  });
+  worker.join();
+  EXPECT_TRUE(lowered);
+  EXPECT_EQ(worker_before, caller_before);  // a new thread starts at its creator's priority
+  EXPECT_EQ(worker_after, std::min(19, caller_before + 3));
+  EXPECT_EQ(this_thread_nice(), caller_before);
+}
+
+TEST(ThreadPriority, ZeroOrNegativeIncrementChangesNothing) {
+  std::thread worker([] {
+    const int before = this_thread_nice();
+    EXPECT_TRUE(lower_this_thread_priority(0));
+    EXPECT_TRUE(lower_this_thread_priority(-5));
+    EXPECT_EQ(this_thread_nice(), before);
+  });
+  worker.join();
+}
+
+}  // namespace
+}  // namespace pspslam

@@ -134,6 +134,7 @@ struct RunFlags {
   std::string dynamic = "auto";
   std::string model;  // empty: the shipped model
   bool realtime = false;
+  std::string preload = "auto";
   int background_nice = -1;  // -1: kLiveBackgroundNice for live runs, else 0
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
@@ -171,6 +172,9 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   if (!flags.sensor.empty()) options.sensor = parse_sensor_type(flags.sensor, "--sensor");
   options.outputs.kitti_trajectory = flags.trajectory_format == "kitti";
   options.max_frames = flags.max_frames;
+  options.preload = flags.preload == "on"    ? Preload::on
+                    : flags.preload == "off" ? Preload::off
+                                             : Preload::automatic;
   if (!flags.blackout.empty()) options.blackout = parse_blackout(flags.blackout);
   options.progress = !global.quiet;
   options.outputs.folder = flags.out;
@@ -332,6 +336,13 @@ Command add_run_command(CLI::App& root) {
                 "segmentation or local mapping: use the newest mask, warped into the frame "
                 "(default: deterministic, each frame waits for its mask and for local mapping "
                 "to finish the previous keyframe)");
+  app->add_option("--preload", flags->preload,
+                  "with --realtime on a recording: on = decode every frame before the replay "
+                  "starts, so that no image decoding shares the cores with the run (a camera "
+                  "delivers decoded frames; refused above 8 GiB), off = decode each frame ahead "
+                  "on a reader thread, auto = on up to 2 GiB of decoded frames")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
   app->add_option("--background-nice", flags->background_nice,
                   "scheduling priority given up by the semantic, local mapping and loop closing "
                   "threads (nice increment, 0-19) so that tracking gets a core when a frame "

@@ -268,5 +268,52 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   EXPECT_EQ(delivered + paced.stats().dropped, 20u);
 }
 
+// --preload: a consumer that keeps up gets every frame, decoded before the clock started, each
+// at its due time; preloading an unpaced source is refused.
+TEST(SequenceSource, PreloadedPacedSourceDeliversEveryFrameWhenDue) {
+  const auto dir = testing::make_temp_dir("capture_preload");
+  const auto config = dir / "camera.yaml";
+  std::ofstream(config) << "camera:\n  width: 8\n  height: 6\n  fx: 10\n  fy: 10\n  cx: 4\n"
+                           "  cy: 3\n  distortion: [0, 0, 0, 0]\n  fps: 50\n  depth_factor: 5000\n"
+                           "  depth_threshold: 3\n";
+  {
+    SequenceRecorder recorder(dir / "seq", config, 5000.0);
+    for (int i = 0; i < 12; ++i) {
+      RgbdFrame frame;
+      frame.timestamp = frame.depth_timestamp = 50.0 + i * 0.02;
+      frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar::all(10 * i));
+      frame.depth = cv::Mat(6, 8, CV_32FC1, cv::Scalar(1.0f));
+      recorder.add(frame);
+    }
+  }
+  SequenceSource source(open_sequence_with_config(dir / "seq", std::nullopt, nullptr), 0, true,
+                        Preload::on);
+  size_t delivered = 0;
+  std::optional<std::chrono::steady_clock::time_point> first_arrival;
+  while (const std::optional<RgbdFrame> frame = source.next()) {
+    EXPECT_EQ(frame->index, delivered);
+    EXPECT_EQ(frame->bgr.at<cv::Vec3b>(0, 0)[0], 10 * delivered);
+    ASSERT_TRUE(frame->arrival);
+    if (!first_arrival) first_arrival = frame->arrival;
+    const double due_ms =
+        std::chrono::duration<double, std::milli>(*frame->arrival - *first_arrival).count();
+    EXPECT_NEAR(due_ms, 20.0 * static_cast<double>(frame->index), 1e-3);
+    ++delivered;
+  }
+  EXPECT_EQ(delivered, 12u);
+  EXPECT_EQ(source.stats().dropped, 0u);
+  EXPECT_TRUE(source.describe().ends_with(
+      "replay:       paced at the recording's rate; every frame decoded before the start (0.00 "
+      "GiB, --preload)\n"))
+      << source.describe();
+  try {
+    SequenceSource unpaced(open_sequence_with_config(dir / "seq", std::nullopt, nullptr), 0, false,
+                           Preload::on);
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "--preload: only a --realtime run replays at the camera's rate");
+  }
+}
+
 }  // namespace
 }  // namespace pspslam

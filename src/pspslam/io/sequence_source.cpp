@@ -2,15 +2,53 @@
 
 #include <algorithm>
 #include <exception>
+#include <iomanip>
+#include <sstream>
 #include <utility>
+
+#include "pspslam/core/error.h"
 
 namespace pspslam {
 
-SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool paced)
+namespace {
+
+size_t frame_bytes(const RgbdFrame& frame) {
+  size_t bytes = 0;
+  for (const cv::Mat* image : {&frame.bgr, &frame.depth, &frame.right})
+    bytes += image->total() * image->elemSize();
+  return bytes;
+}
+
+}  // namespace
+
+SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool paced, Preload preload)
     : setup_(std::move(setup)),
       frames_(max_frames == 0 ? setup_.sequence.size()
                               : std::min(setup_.sequence.size(), max_frames)),
       paced_(paced) {
+  if (preload == Preload::on && !paced_)
+    throw Error("--preload: only a --realtime run replays at the camera's rate");
+  if (paced_ && preload != Preload::off && frames_ > 0) {
+    RgbdFrame first = setup_.sequence.load(0);
+    const double need = static_cast<double>(frame_bytes(first)) * static_cast<double>(frames_);
+    const size_t limit = preload == Preload::on ? kPreloadLimitBytes : kAutoPreloadBytes;
+    if (need <= static_cast<double>(limit)) {
+      preloaded_.reserve(frames_);
+      preloaded_.push_back(std::move(first));
+      for (size_t index = 1; index < frames_; ++index)
+        preloaded_.push_back(setup_.sequence.load(index));
+      preloaded_bytes_ = static_cast<size_t>(need);
+    } else if (preload == Preload::on) {
+      std::ostringstream message;
+      message << std::fixed << std::setprecision(1) << "--preload: " << frames_ << " frames of "
+              << setup_.sequence.directory().string() << " decode to "
+              << need / static_cast<double>(size_t{1} << 30) << " GiB, more than the "
+              << (kPreloadLimitBytes >> 30)
+              << " GiB limit; run with --preload off (frames are then decoded ahead on a "
+                 "reader thread)";
+      throw Error(message.str());
+    }
+  }
   if (paced_) reader_ = std::jthread([this](const std::stop_token& stop) { read_paced(stop); });
 }
 
@@ -44,7 +82,7 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
       index = newest;
       // Decoded ahead, delivered when due; one that is late when decoded is delivered at once,
       // and that lateness counts in its latency (its arrival stays the due time).
-      RgbdFrame frame = sequence.load(index);
+      RgbdFrame frame = preloaded_.empty() ? sequence.load(index) : std::move(preloaded_[index]);
       const auto due = due_time(index);
       {
         std::unique_lock lock(start_mutex_);
@@ -82,6 +120,23 @@ std::optional<RgbdFrame> SequenceSource::next() {
       return std::nullopt;
     }
   }
+}
+
+std::string SequenceSource::describe() const {
+  std::string text = describe_sequence(setup_);
+  if (paced_) {
+    std::ostringstream line;
+    line << "replay:       paced at the recording's rate; ";
+    if (preloaded_.size() == frames_ && frames_ > 0)
+      line << std::fixed << std::setprecision(2) << "every frame decoded before the start ("
+           << static_cast<double>(preloaded_bytes_) / static_cast<double>(size_t{1} << 30)
+           << " GiB, --preload)";
+    else
+      line << "frames decoded ahead on a reader thread (--preload off or above "
+           << (kAutoPreloadBytes >> 30) << " GiB)";
+    text += line.str() + "\n";
+  }
+  return text;
 }
 
 }  // namespace pspslam

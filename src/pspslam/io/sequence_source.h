@@ -10,6 +10,7 @@
 #include <stop_token>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "pspslam/core/latest_queue.h"
 #include "pspslam/io/frame_source.h"
@@ -26,11 +27,21 @@ namespace pspslam {
 // was delivered counts as dropped, as does one the reader skipped because it was late itself.
 // A frame's `arrival` is its due time: what a camera delivers decoded at that moment, so the
 // decoding of the recording's image files, which a camera does not have, is not part of the
-// latency measured from it (issue #18).
+// latency measured from it (issue #18). A paced source may also decode every frame in the
+// constructor, before the clock starts (`preload`, `run --preload`), so that the replay puts no
+// decoding on the cores while it runs, as a camera would not: `on` does it or refuses (an Error)
+// above kPreloadLimitBytes of decoded frames, `automatic` does it up to kAutoPreloadBytes and
+// otherwise decodes on the reader thread.
+enum class Preload { off, automatic, on };
+
 class SequenceSource final : public FrameSource {
  public:
+  static constexpr size_t kPreloadLimitBytes = size_t{8} << 30;
+  static constexpr size_t kAutoPreloadBytes = size_t{2} << 30;  // the complete Bonn clip fits
+
   // `max_frames` 0 = all.
-  SequenceSource(SequenceSetup setup, size_t max_frames, bool paced);
+  SequenceSource(SequenceSetup setup, size_t max_frames, bool paced,
+                 Preload preload = Preload::off);
   ~SequenceSource() override;  // stops and joins the reader
   SequenceSource(const SequenceSource&) = delete;
   SequenceSource& operator=(const SequenceSource&) = delete;
@@ -38,7 +49,7 @@ class SequenceSource final : public FrameSource {
   std::optional<RgbdFrame> next() override;
   std::optional<size_t> frame_count() const override { return frames_; }
   std::string name() const override { return setup_.sequence.directory().string(); }
-  std::string describe() const override { return describe_sequence(setup_); }
+  std::string describe() const override;
   const std::optional<Trajectory>& ground_truth() const override {
     return setup_.sequence.ground_truth();
   }
@@ -57,7 +68,9 @@ class SequenceSource final : public FrameSource {
   SequenceSetup setup_;
   size_t frames_ = 0;
   bool paced_ = false;
-  size_t next_index_ = 0;  // deterministic reading
+  size_t next_index_ = 0;             // deterministic reading
+  std::vector<RgbdFrame> preloaded_;  // --preload: every frame, decoded before the run
+  size_t preloaded_bytes_ = 0;
   LatestQueue<RgbdFrame> delivered_{1};
   std::atomic<size_t> skipped_{0};  // frames the reader never decoded: it was late for them
   std::mutex start_mutex_;

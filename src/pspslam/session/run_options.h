@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "pspslam/io/sequence_source.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam {
@@ -44,6 +45,9 @@ struct RunOptions {
   // `pspslam run --sensor`: overrides the config's camera.type (io/sequence_setup.h).
   std::optional<SensorType> sensor;
   size_t max_frames = 0;  // 0 = all
+  // `pspslam run --preload` (with --realtime): decode every frame before the paced replay starts
+  // (io/sequence_source.h).
+  Preload preload = Preload::automatic;
   // Frames fed as black images without depth: tracking is really lost (relocalisation tests).
   std::optional<FrameRange> blackout;
   RunOutputs outputs;

@@ -56,7 +56,7 @@ RunInput open_sequence_input(const RunOptions& options) {
       spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr, options.sensor);
   RunInput input{setup.config_file, setup.config, nullptr};
   input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
-                                                  options.system.dynamic.realtime);
+                                                  options.system.dynamic.realtime, options.preload);
   return input;
 }
 

@@ -215,22 +215,28 @@ TEST(SequenceRecorder, WritesATumSequenceThatReadsBackFramePerFrame) {
             std::string::npos);
 }
 
-TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
-  const auto dir = testing::make_temp_dir("capture_source");
+// Records an 8x6 sequence of `frames` frames at `fps` into DIR/seq (returned): frame i is grey
+// level grey_step * i with 1 m depth everywhere.
+std::filesystem::path record_tiny_sequence(const std::filesystem::path& dir, int frames, int fps,
+                                           int grey_step) {
   const auto config = dir / "camera.yaml";
   std::ofstream(config) << "camera:\n  width: 8\n  height: 6\n  fx: 10\n  fy: 10\n  cx: 4\n"
-                           "  cy: 3\n  distortion: [0, 0, 0, 0]\n  fps: 100\n  depth_factor: 5000\n"
-                           "  depth_threshold: 3\n";
-  {
-    SequenceRecorder recorder(dir / "seq", config, 5000.0);
-    for (int i = 0; i < 20; ++i) {
-      RgbdFrame frame;
-      frame.timestamp = frame.depth_timestamp = 50.0 + i * 0.01;
-      frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar::all(i));
-      frame.depth = cv::Mat(6, 8, CV_32FC1, cv::Scalar(1.0f));
-      recorder.add(frame);
-    }
+                           "  cy: 3\n  distortion: [0, 0, 0, 0]\n  fps: "
+                        << fps << "\n  depth_factor: 5000\n  depth_threshold: 3\n";
+  SequenceRecorder recorder(dir / "seq", config, 5000.0);
+  for (int i = 0; i < frames; ++i) {
+    RgbdFrame frame;
+    frame.timestamp = frame.depth_timestamp = 50.0 + i / static_cast<double>(fps);
+    frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar::all(grey_step * i));
+    frame.depth = cv::Mat(6, 8, CV_32FC1, cv::Scalar(1.0f));
+    recorder.add(frame);
   }
+  return dir / "seq";
+}
+
+TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
+  const auto dir = testing::make_temp_dir("capture_source");
+  record_tiny_sequence(dir, 20, 100, 1);
   SequenceSource all(open_sequence_with_config(dir / "seq", std::nullopt, nullptr), 15, false);
   EXPECT_EQ(all.frame_count(), 15u);
   EXPECT_EQ(all.name(), (dir / "seq").string());
@@ -272,20 +278,7 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
 // at its due time; preloading an unpaced source is refused.
 TEST(SequenceSource, PreloadedPacedSourceDeliversEveryFrameWhenDue) {
   const auto dir = testing::make_temp_dir("capture_preload");
-  const auto config = dir / "camera.yaml";
-  std::ofstream(config) << "camera:\n  width: 8\n  height: 6\n  fx: 10\n  fy: 10\n  cx: 4\n"
-                           "  cy: 3\n  distortion: [0, 0, 0, 0]\n  fps: 50\n  depth_factor: 5000\n"
-                           "  depth_threshold: 3\n";
-  {
-    SequenceRecorder recorder(dir / "seq", config, 5000.0);
-    for (int i = 0; i < 12; ++i) {
-      RgbdFrame frame;
-      frame.timestamp = frame.depth_timestamp = 50.0 + i * 0.02;
-      frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar::all(10 * i));
-      frame.depth = cv::Mat(6, 8, CV_32FC1, cv::Scalar(1.0f));
-      recorder.add(frame);
-    }
-  }
+  record_tiny_sequence(dir, 12, 50, 10);
   SequenceSource source(open_sequence_with_config(dir / "seq", std::nullopt, nullptr), 0, true,
                         Preload::on);
   size_t delivered = 0;

@@ -1,6 +1,5 @@
 #include "pspslam/mapping/map_point_creation.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
@@ -8,6 +7,7 @@
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
 #include "pspslam/mapping/keyframe_matching.h"
+#include "pspslam/solve/triangulation.h"
 
 namespace pspslam {
 namespace {
@@ -32,19 +32,6 @@ Eigen::Vector3d bearing_world(const KeyFrame& keyframe, int index, const Pose& T
   const PinholeCamera& pinhole = keyframe.camera().pinhole;
   const Eigen::Vector3d ray((p.x - pinhole.cx) / pinhole.fx, (p.y - pinhole.cy) / pinhole.fy, 1.0);
   return T_world_camera.linear() * ray;
-}
-
-// Linear (DLT) triangulation from two normalised image points and the 3×4 projections.
-Eigen::Vector3d triangulate(const Eigen::Vector2d& x1, const Eigen::Matrix<double, 3, 4>& P1,
-                            const Eigen::Vector2d& x2, const Eigen::Matrix<double, 3, 4>& P2) {
-  Eigen::Matrix4d A;
-  A.row(0) = x1.x() * P1.row(2) - P1.row(0);
-  A.row(1) = x1.y() * P1.row(2) - P1.row(1);
-  A.row(2) = x2.x() * P2.row(2) - P2.row(0);
-  A.row(3) = x2.y() * P2.row(2) - P2.row(1);
-  const Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
-  const Eigen::Vector4d h = svd.matrixV().col(3);
-  return h.head<3>() / h(3);
 }
 
 Eigen::Vector2d normalised(const KeyFrame& keyframe, int index) {
@@ -128,7 +115,7 @@ std::vector<std::shared_ptr<MapPoint>> create_points_by_triangulation(
 
       Eigen::Vector3d position;
       if (rays_cos < best_depth_cos && rays_cos > 0.0 && (has_depth || rays_cos < 0.9998)) {
-        position = triangulate(normalised(*keyframe, i1), P1, normalised(*neighbour, i2), P2);
+        position = triangulate_dlt(normalised(*keyframe, i1), P1, normalised(*neighbour, i2), P2);
         if (!position.allFinite()) continue;
       } else if (depth_cos1 <= 1.0 && depth_cos1 <= depth_cos2) {
         position = keyframe->unproject_world(i1);

@@ -12,6 +12,8 @@
 #include <opencv2/core/eigen.hpp>
 #include <random>
 
+#include "pspslam/solve/triangulation.h"
+
 namespace pspslam {
 
 const char* to_string(TwoViewModel model) {
@@ -197,19 +199,6 @@ ModelFit fit(Kind kind, std::span<const Eigen::Vector2d> p1, std::span<const Eig
   return best;
 }
 
-// Linear triangulation (Hartley & Zisserman 12.2) from pixels and 3x4 projection matrices.
-Eigen::Vector3d triangulate(const Eigen::Vector2d& x1, const Matrix34& P1,
-                            const Eigen::Vector2d& x2, const Matrix34& P2) {
-  Eigen::Matrix4d A;
-  A.row(0) = x1.x() * P1.row(2) - P1.row(0);
-  A.row(1) = x1.y() * P1.row(2) - P1.row(1);
-  A.row(2) = x2.x() * P2.row(2) - P2.row(0);
-  A.row(3) = x2.y() * P2.row(2) - P2.row(1);
-  const Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
-  const Eigen::Vector4d h = svd.matrixV().col(3);
-  return h.head<3>() / h(3);
-}
-
 struct Hypothesis {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
@@ -241,7 +230,7 @@ void check_motion(Hypothesis& h, const PinholeCamera& camera, std::span<const Ei
   h.num_triangulated = 0;
   for (size_t i = 0; i < p1.size(); ++i) {
     if (!inlier[i]) continue;
-    const Eigen::Vector3d X = triangulate(p1[i], P1, p2[i], P2);
+    const Eigen::Vector3d X = triangulate_dlt(p1[i], P1, p2[i], P2);
     if (!X.allFinite()) continue;
     const Eigen::Vector3d ray2 = X - center2;
     const double cos_parallax = X.dot(ray2) / (X.norm() * ray2.norm());

@@ -191,6 +191,7 @@ function showMap(map) {
   $('map-keyframes').textContent = map.keyframes.length;
   body.dataset.mapPoints = map.positions.length / 3;
   body.dataset.keyframes = map.keyframes.length;
+  body.dataset.covisibilityEdges = map.edges.length;
   if (!framed && centres.length >= 2 && map.positions.length) {
     // Look from above and behind the first keyframe (SLAM's z forward is -z here) towards the
     // map's median point: the median ignores the few far points a bounding box would chase.

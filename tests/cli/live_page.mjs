@@ -35,13 +35,15 @@ try {
   await page.click('#resume');
   await page.waitForFunction(`Number(document.body.dataset.mapPoints) > 0 &&
                               Number(document.body.dataset.keyframes) >= 2 &&
-                              Number(document.body.dataset.dynamicSeen) > 0`,
+                              Number(document.body.dataset.dynamicSeen) > 0 &&
+                              Number(document.body.dataset.covisibilityEdges) > 0`,
                              null, { timeout: 240000 });
   await page.click('#pause');
   await page.waitForFunction(held, null, { timeout: 60000 });
   const paused = await data(page);
   seen.map_points = Number(paused.mapPoints);
   seen.keyframes = Number(paused.keyframes);
+  seen.covisibility_edges = Number(paused.covisibilityEdges);
   seen.dynamic_seen = Number(paused.dynamicSeen);
   seen.paused = Number(paused.frame);
   await sleep(2000);

@@ -131,6 +131,9 @@ TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
   // Running, the map and the dynamic keypoints showed up.
   EXPECT_GT(seen["map_points"].get<int>(), 100);
   EXPECT_GE(seen["keyframes"].get<int>(), 2);
+  // Local mapping links a new keyframe to the others a little after it is made: the page waits
+  // for a map with covisibility edges before it pauses, so the edge toggle has something to hide.
+  EXPECT_GT(seen["covisibility_edges"].get<int>(), 0);
   EXPECT_GT(seen["dynamic_seen"].get<int>(), 0);
   // The toggles (on held frames): keypoints off leaves the canvas empty (the ant path is off by
   // default), the ant path alone draws something, both back give the same picture; the label

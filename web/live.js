@@ -213,11 +213,12 @@ function showMap(map) {
 
 const visibility = () => {
   layers.covisibility.visible = $('show-covis').checked;
+  layers.trajectory.visible = $('show-trajectory').checked;
   layers.truth.visible = $('show-truth').checked;
   requestRender();
 };
-$('show-covis').addEventListener('change', visibility);
-$('show-truth').addEventListener('change', visibility);
+for (const id of ['show-covis', 'show-trajectory', 'show-truth'])
+  $(id).addEventListener('change', visibility);
 view.world.updateMatrixWorld();
 // Drawn on demand, not every display frame: on a machine without a GPU the browser renders
 // WebGL in software, and a continuous loop would take a core from the SLAM run it shows.

@@ -35,6 +35,7 @@
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
+#include "pspslam/core/thread_priority.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/video_source.h"
 #include "pspslam/place/place_recognition.h"
@@ -166,6 +167,7 @@ std::filesystem::path user_or_default(const std::string& typed,
 }
 
 int run_slam(const RunFlags& flags, const GlobalOptions& global) {
+  use_single_threaded_blas();  // in every run: its calls are small, its spinning workers are not
   RunOptions options;
   options.sequence = flags.sequence;
   if (!flags.config.empty()) options.config = flags.config;

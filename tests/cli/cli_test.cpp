@@ -550,6 +550,7 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
 // (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
 // `scheduling`: a real-time run lowers the background threads (nice 10) and gives OpenCV one
 // thread; a deterministic run changes neither; --background-nice / --opencv-threads override.
+// Both keep BLAS on one thread.
 TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   const auto dir = testing::make_temp_dir("cli_latency");
   const Result synth =
@@ -591,6 +592,11 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_EQ(arrival_column("deterministic"), std::vector<std::string>(30, ""));
   EXPECT_EQ(scheduling["background_thread_nice"].get<int>(), 0);
   EXPECT_EQ(scheduling["opencv_threads"].get<int>(), cv::getNumThreads());
+  // Every run keeps OpenBLAS on one thread (0: the BLAS is another one, with no threads to set).
+  for (const nlohmann::json* run : {&live_scheduling, &scheduling}) {
+    EXPECT_GE((*run)["blas_threads"].get<int>(), 0);
+    EXPECT_LE((*run)["blas_threads"].get<int>(), 1);
+  }
   const auto [chosen_latency, chosen_frames, chosen] =
       latency("chosen", "--realtime --background-nice 3 --opencv-threads 2");
   EXPECT_EQ(chosen["background_thread_nice"].get<int>(), 3);

@@ -33,7 +33,9 @@ try {
   seen.step_later = Number((await data(page)).frame);
 
   await page.click('#resume');
-  await page.waitForFunction(`Number(document.body.dataset.mapPoints) > 0 &&
+  // Far enough that the trajectory and the edges span more than a few pixels of the 3D view.
+  await page.waitForFunction(`Number(document.body.dataset.frame) >= 60 &&
+                              Number(document.body.dataset.mapPoints) > 0 &&
                               Number(document.body.dataset.keyframes) >= 2 &&
                               Number(document.body.dataset.dynamicSeen) > 0 &&
                               Number(document.body.dataset.covisibilityEdges) > 0`,
@@ -60,8 +62,8 @@ try {
     return drawn;
   });
   const display = (id) => page.evaluate((id) => getComputedStyle(document.getElementById(id)).display, id);
-  // 3D view: pixels of the covisibility edges' green (0x3a9d54) in the WebGL canvas.
-  const covisPixels = () => page.evaluate(() => {
+  // 3D view: pixels of one colour (within 24 per channel) in the WebGL canvas.
+  const colourPixels = (rgb) => page.evaluate((rgb) => {
     const gl = document.querySelector('#scene canvas');
     const copy = document.createElement('canvas');
     copy.width = gl.width;
@@ -69,13 +71,14 @@ try {
     const g = copy.getContext('2d');
     g.drawImage(gl, 0, 0);
     const pixels = g.getImageData(0, 0, copy.width, copy.height).data;
-    let green = 0;
+    let count = 0;
     for (let i = 0; i < pixels.length; i += 4) {
-      green += Math.abs(pixels[i] - 0x3a) < 24 && Math.abs(pixels[i + 1] - 0x9d) < 24 &&
-               Math.abs(pixels[i + 2] - 0x54) < 24;
+      count += Math.abs(pixels[i] - rgb[0]) < 24 && Math.abs(pixels[i + 1] - rgb[1]) < 24 &&
+               Math.abs(pixels[i + 2] - rgb[2]) < 24;
     }
-    return green;
-  });
+    return count;
+  }, rgb);
+  const covisPixels = () => colourPixels([0x3a, 0x9d, 0x54]);  // the edges' green
   const settle = () => sleep(400);  // a change is drawn on the next animation frame
   seen.marks_on = await marks();
   await page.click('#show-keypoints');
@@ -93,6 +96,14 @@ try {
   await settle();
   seen.labels_hidden = await display('labels');
   await page.click('#show-labels');
+  // The trajectory passes through every keyframe and is drawn after the edges: an edge between
+  // two consecutive keyframes can lie entirely under it, so it is hidden while the edges are
+  // counted (and counted itself: its orange goes and comes back).
+  const orange = () => colourPixels([0xe8, 0xa3, 0x3d]);
+  seen.trajectory_on = await orange();
+  await page.click('#show-trajectory');
+  await settle();
+  seen.trajectory_off = await orange();
   seen.covis_on = await covisPixels();
   await page.click('#show-covis');
   await settle();
@@ -100,6 +111,9 @@ try {
   await page.click('#show-covis');
   await settle();
   seen.covis_back = await covisPixels();
+  await page.click('#show-trajectory');
+  await settle();
+  seen.trajectory_back = await orange();
   // Follow camera: off, a step leaves the orbit target where it is; on, a step moves it.
   const stepOnce = async () => {
     const before = Number((await data(page)).frame);

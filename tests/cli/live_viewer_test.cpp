@@ -144,7 +144,10 @@ TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
   EXPECT_EQ(seen["marks_back"], seen["marks_on"]);
   EXPECT_EQ(seen["labels_shown"], "block");
   EXPECT_EQ(seen["labels_hidden"], "none");
-  EXPECT_GT(seen["covis_on"].get<int>(), 0);
+  EXPECT_GT(seen["trajectory_on"].get<int>(), 0);
+  EXPECT_LT(seen["trajectory_off"].get<int>(), seen["trajectory_on"].get<int>());
+  EXPECT_EQ(seen["trajectory_back"], seen["trajectory_on"]);
+  EXPECT_GT(seen["covis_on"].get<int>(), 0) << seen.dump();
   EXPECT_EQ(seen["covis_off"], 0);
   EXPECT_EQ(seen["covis_back"], seen["covis_on"]);
   // Follow camera: the orbit target stays without it and moves with the camera with it.
@@ -153,6 +156,7 @@ TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
   EXPECT_EQ(seen["held_after_toggles"].get<int>(), seen["paused"].get<int>() + 2);  // two steps
   // Pause stops the frame counter; step moves it by one.
   EXPECT_EQ(seen["paused_step"].get<int>(), seen["held_after_toggles"].get<int>() + 1);
+  EXPECT_GE(seen["paused"].get<int>(), 60);
   EXPECT_LT(seen["paused"].get<int>(), kFrames - 1);
   EXPECT_TRUE(seen.value("finished", false));
 

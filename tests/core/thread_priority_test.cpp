@@ -34,5 +34,12 @@ TEST(ThreadPriority, ZeroOrNegativeIncrementChangesNothing) {
   worker.join();
 }
 
+// Debian's BLAS is OpenBLAS (pthreads), linked through OpenCV: told to, it runs on one thread;
+// another BLAS has no thread count to report.
+TEST(ThreadPriority, BlasRunsOnTheCallingThread) {
+  const bool openblas = use_single_threaded_blas();
+  EXPECT_EQ(blas_threads(), openblas ? 1 : 0);
+}
+
 }  // namespace
 }  // namespace pspslam

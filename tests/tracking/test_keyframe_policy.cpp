@@ -27,9 +27,16 @@ TEST(KeyFramePolicy, KeyFrameWhenFewerPointsThanTheReference) {
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsert);
   e.mapper_idle = false;
   e.last_keyframe_frame_id = 99;
-  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);  // busy and not yet due
+  // Busy with nothing queued: the keyframe goes in and cuts the mapper's BA short.
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
+  KeyFramePolicyOptions orb_slam2;
+  orb_slam2.insert_while_mapping = false;
+  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kSkip);  // busy and not yet due
+  e.mapper_queue = 1;
+  EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kSkip);  // one waits already, not yet due
   e.last_keyframe_frame_id = 60;                               // due: 40 > 30 frames
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInsertInterruptingMapper);
+  EXPECT_EQ(decide_keyframe(e, orb_slam2), KeyFrameDecision::kInsertInterruptingMapper);
   e.mapper_queue = 3;
   EXPECT_EQ(decide_keyframe(e, {}), KeyFrameDecision::kInterruptMapper);
 }

@@ -1,5 +1,6 @@
 #include "pspslam/core/thread_priority.h"
 
+#include <dlfcn.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -17,6 +18,20 @@ bool lower_this_thread_priority(int increment) {
   // With a thread id, PRIO_PROCESS addresses that thread alone (Linux's per-thread nice).
   return setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), this_thread_nice() + increment) ==
          0;
+}
+
+bool use_single_threaded_blas() {
+  using SetThreads = void (*)(int);
+  void* const symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+  if (symbol == nullptr) return false;
+  reinterpret_cast<SetThreads>(symbol)(1);
+  return true;
+}
+
+int blas_threads() {
+  using GetThreads = int (*)();
+  void* const symbol = dlsym(RTLD_DEFAULT, "openblas_get_num_threads");
+  return symbol == nullptr ? 0 : reinterpret_cast<GetThreads>(symbol)();
 }
 
 }  // namespace pspslam

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pspslam/core/error.h"
+#include "pspslam/core/thread_priority.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/eval/stats.h"
 #include "pspslam/session/frame_log.h"
@@ -101,9 +102,11 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   out << line;
   std::snprintf(line, sizeof(line),
                 "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
-                "%zu fused, %zu culled, %zu BA outlier observations removed\n",
+                "%zu fused, %zu culled, %zu BA outlier observations removed; %zu local BAs cut "
+                "short\n",
                 mapping.processed_keyframes, mapping.keyframes_culled, mapping.points_triangulated,
-                mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed);
+                mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed,
+                mapping.local_ba_cut_short);
   out << line;
   if (system.place.loop_closing) print_loop_stats(mapping, out);
   if (!input.loop_closing_note.empty())
@@ -244,8 +247,12 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                      {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
   // How the threads shared the cores (issue #18 item 1's levers), to read beside the latency.
   json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
-                        {"opencv_threads", cv::getNumThreads()}};
-  json["map"] = {{"keyframes", mapping.keyframes_in_map}, {"map_points", mapping.map_points}};
+                        {"opencv_threads", cv::getNumThreads()},
+                        {"blas_threads", blas_threads()}};
+  json["map"] = {{"keyframes", mapping.keyframes_in_map},
+                 {"map_points", mapping.map_points},
+                 {"keyframes_processed", mapping.processed_keyframes},
+                 {"local_ba_cut_short", mapping.local_ba_cut_short}};
   json["loops"] = {{"enabled", system.place.loop_closing},
                    {"closed", mapping.loops_closed},
                    {"global_ba_applied", mapping.global_ba_applied}};

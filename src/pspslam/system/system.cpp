@@ -141,6 +141,7 @@ class System::MappingConnection final : public KeyFrameSink {
     stats.points_triangulated = last_.points_triangulated;
     stats.points_fused = last_.points_fused;
     stats.ba_outliers_removed = last_.ba_outliers_removed;
+    stats.local_ba_cut_short = last_.bundle_adjustments_interrupted;
   }
 
  private:

@@ -99,6 +99,7 @@ struct MappingStats {
   size_t points_triangulated = 0;
   size_t points_fused = 0;
   size_t ba_outliers_removed = 0;
+  size_t local_ba_cut_short = 0;  // stopped for a newer keyframe (or the time budget)
   // Loop closing (all zero when it is off).
   size_t loops_closed = 0;
   size_t loop_candidates_rejected = 0;  // consistent BoW candidates failing verification

@@ -30,6 +30,14 @@ struct KeyFramePolicyOptions {
   // by default: on the panel's Kinect-faults cells it wins 2 and loses 2 beyond their spread (the
   // ideal and dev-clip cells never trigger it). `pspslam run --due-keyframes` sets it.
   bool insert_when_due = false;
+  // A wanted keyframe (the ratio test) is also inserted while the mapper is busy, as long as
+  // nothing waits in its queue; the bundle adjustment in progress is cut short for it. ORB-SLAM2
+  // waits for an idle mapper unless a keyframe is due or tracking is weak. A deterministic run
+  // always meets an idle mapper (it waits for local mapping), so this changes nothing there; a
+  // real-time run rarely did, and made a third fewer keyframes than the same clip run
+  // deterministically (bonn_crowd_dev `full`: 46-50 against 71), online ATE 1.4 mm worse
+  // (docs/benchmarks.md, issue #18 item 1).
+  bool insert_while_mapping = true;
 };
 
 struct KeyFrameEvidence {

@@ -11,6 +11,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <thread>
 #include <unordered_map>
 #include <utility>
 
@@ -171,7 +172,11 @@ LiveViewer::~LiveViewer() {
   }
   work_.notify_all();
   changed_.notify_all();
-  // Event streams see closing_ and end, then the server's threads can be joined.
+  // Event streams send what they have not sent yet, see closing_ and end (a page that stopped
+  // reading gets a second), then the server's threads can be joined.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  while (server_.open_event_streams() > 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   server_.stop();
   encoder_.join();
 }
@@ -354,9 +359,13 @@ std::optional<std::string> LiveViewer::next_event(std::uint64_t& last) {
   std::unique_lock lock(mutex_);
   if (!changed_.wait_for(lock, std::chrono::seconds(1), [&] { return closing_ || event_ != last; }))
     return std::string();  // keep-alive
-  if (closing_) return std::nullopt;
-  last = event_;
-  return event_json();
+  // The last change first, then the end of the stream: the run's end (state "ended") comes just
+  // before the viewer closes, and a page that missed it would wait for a run that is over.
+  if (event_ != last) {
+    last = event_;
+    return event_json();
+  }
+  return std::nullopt;
 }
 
 std::string LiveViewer::event_json() const {

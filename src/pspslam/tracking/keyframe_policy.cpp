@@ -16,14 +16,14 @@ KeyFrameDecision decide_keyframe(const KeyFrameEvidence& e, const KeyFramePolicy
                                      : o.tracked_ratio_to_reference;
   const bool due = e.frame_id >= e.last_keyframe_frame_id + o.max_frames_between;
   const bool mapper_can_take_one = e.mapper_idle || (o.insert_while_mapping && e.mapper_queue == 0);
-  const bool idle_and_allowed =
+  const bool mapper_ready_and_allowed =
       e.frame_id >= e.last_keyframe_frame_id + o.min_frames_between && mapper_can_take_one;
   const bool weak = e.tracked_inliers < e.reference_tracked_points * 0.25 || need_close;
   const bool fewer_than_reference =
       (e.tracked_inliers < e.reference_tracked_points * ratio_threshold || need_close) &&
       e.tracked_inliers > 15;
   const bool due_anyway = o.insert_when_due && due && e.tracked_inliers > 15;
-  if (!due_anyway && !((due || idle_and_allowed || weak) && fewer_than_reference)) {
+  if (!due_anyway && !((due || mapper_ready_and_allowed || weak) && fewer_than_reference)) {
     return KeyFrameDecision::kSkip;
   }
   if (e.mapper_idle) return KeyFrameDecision::kInsert;

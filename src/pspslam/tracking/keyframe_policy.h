@@ -35,8 +35,8 @@ struct KeyFramePolicyOptions {
   // waits for an idle mapper unless a keyframe is due or tracking is weak. A deterministic run
   // always meets an idle mapper (it waits for local mapping), so this changes nothing there; a
   // real-time run rarely did, and made a third fewer keyframes than the same clip run
-  // deterministically (bonn_crowd_dev `full`: 46-50 against 71), online ATE 1.4 mm worse
-  // (docs/benchmarks.md, issue #18 item 1).
+  // deterministically (bonn_crowd_dev `full`: 46-50 against 71); with this on, it won the online
+  // ATE in 9 of 10 interleaved pairs (docs/benchmarks.md, issue #18 item 1).
   bool insert_while_mapping = true;
 };
 

@@ -139,6 +139,7 @@ struct RunFlags {
   int background_nice = -1;  // -1: kLiveBackgroundNice for live runs, else 0
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
+  int segment_every = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
@@ -211,6 +212,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   }
   dynamic.realtime = flags.realtime;
   dynamic.semantic.mask_dilation_px = flags.mask_margin;
+  dynamic.segment_every = flags.segment_every;
   dynamic.culling.min_dynamic_hits = flags.cull_hits;
   system.place.relocalization = !flags.no_relocalization;
   if (!flags.load_map.empty()) {
@@ -357,6 +359,11 @@ Command add_run_command(CLI::App& root) {
                   "cores). Default: 1 with --realtime or --camera, so that the network runs on "
                   "the lowered semantic thread alone; OpenCV's default otherwise")
       ->check(in_range(0, 256));
+  app->add_option("--segment-every", flags->segment_every,
+                  "segment every n-th frame; the frames between use the newest mask, moved "
+                  "with the camera by the frame-to-frame homographies")
+      ->check(in_range(1, 30))
+      ->capture_default_str();
   app->add_option("--mask-margin", flags->mask_margin,
                   "dilation of the semantic dynamic mask (pixels)")
       ->check(in_range(0, 100))

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <sstream>
 #include <tuple>
 
 #include "pspslam/core/shared_paths.h"
@@ -601,6 +603,44 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
       latency("chosen", "--realtime --background-nice 3 --opencv-threads 2");
   EXPECT_EQ(chosen["background_thread_nice"].get<int>(), 3);
   EXPECT_EQ(chosen["opencv_threads"].get<int>(), 2);
+}
+
+// --segment-every (issue #18's lever): only every n-th frame goes to the network; the frames
+// between use the newest mask moved by the homographies, so a deterministic run's mask ages are
+// 0, 1, 0, 1, ... and the network runs on half the frames.
+TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
+  const auto dir = testing::make_temp_dir("cli_segment_every");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 12 --bodies 2 --seed 5");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                           (dir / "out").string() + " --dynamic semantic --segment-every 2");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(dir / "out" / "stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  EXPECT_EQ(stats["scheduling"]["segment_every"].get<int>(), 2);
+  EXPECT_EQ(stats["timing_ms"]["semantic"]["count"].get<int>(), 6);
+  std::ifstream timing(dir / "out" / "timing.csv");
+  std::string header;
+  std::getline(timing, header);
+  const auto columns = [](const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream stream(line);
+    for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
+    return fields;
+  };
+  const std::vector<std::string> names = columns(header);
+  const auto mask_age = std::find(names.begin(), names.end(), "mask_age") - names.begin();
+  ASSERT_LT(mask_age, static_cast<std::ptrdiff_t>(names.size())) << header;
+  std::vector<std::string> ages;
+  for (std::string row; std::getline(timing, row);) ages.push_back(columns(row)[mask_age]);
+  EXPECT_EQ(ages, (std::vector<std::string>{"0", "1", "0", "1", "0", "1", "0", "1", "0", "1",
+                                            "0", "1"}));
+  const Result bad = pspslam("run --sequence x --segment-every 0");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.output,
+            "error: pspslam run: --segment-every: must be an integer in [1, 30], got '0' (see "
+            "'pspslam run --help')\n");
 }
 
 // --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own

@@ -5,6 +5,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "pspslam/core/shared_paths.h"
 
@@ -25,10 +29,11 @@ bool shared_required() {
 
 std::filesystem::path make_temp_dir(const std::string& tag) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = tag;
-  if (info != nullptr) name += std::string("_") + info->test_suite_name() + "_" + info->name();
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("pspslam_test_" + name);
+  std::ostringstream name;
+  name << "pspslam_test_" << tag;
+  if (info != nullptr) name << '_' << info->test_suite_name() << '_' << info->name();
+  name << '_' << ::getpid();
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / name.str();
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

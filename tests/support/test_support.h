@@ -13,7 +13,9 @@ std::filesystem::path shared_dir_if_present();
 // True when PSPSLAM_REQUIRE_SHARED=1 (set by .ci/run): then a missing ../shared is a failure.
 bool shared_required();
 
-// A fresh, empty temporary directory unique to the running test.
+// A fresh, empty temporary directory unique to the running test and process: ctest runs each
+// test of a suite in its own process, in parallel, and a suite-level fixture (no current test)
+// must not share its folder with the same suite's other processes.
 std::filesystem::path make_temp_dir(const std::string& tag);
 
 // Runs a shell command, returns its exit status; stdout+stderr land in *output.

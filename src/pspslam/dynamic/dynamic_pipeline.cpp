@@ -52,6 +52,8 @@ DynamicPipeline::~DynamicPipeline() = default;
 void DynamicPipeline::announce(const RgbdFrame& frame) {
   if (!semantic_) return;
   const std::int64_t id = next_announced_++;
+  // With a stride the frames in between use the newest mask, warped (semantic_mask()).
+  if (id % options_.segment_every != 0) return;
   submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
   while (submitted_.size() > 64) submitted_.pop_front();
   semantic_->submit(id, frame.timestamp, frame.bgr);
@@ -61,10 +63,11 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
                                      DynamicReport& report) {
   current_id_ = next_id_++;
   labels_.release();
-  if (semantic_ && (submitted_.empty() || submitted_.back().id < current_id_)) announce(frame);
+  if (semantic_ && next_announced_ <= current_id_) announce(frame);
   const auto start = std::chrono::steady_clock::now();
   H_previous_to_current_.reset();
-  if (geometry_ || (semantic_ && options_.realtime)) {
+  // The homographies also move an older mask into this frame (real time, or a stride).
+  if (geometry_ || (semantic_ && (options_.realtime || options_.segment_every > 1))) {
     flow_.track(previous_gray_, gray, previous_points_);
     const CompensatedHomography H = estimate_compensated_homography(
         std::span<const Eigen::Vector2d>(flow_.matched_previous()),
@@ -193,7 +196,9 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
   std::shared_ptr<const SemanticResult> result;
   if (!options_.realtime) {
     const auto start = std::chrono::steady_clock::now();
-    result = semantic_->wait_for(current_id_, options_.semantic_timeout);
+    // The newest frame segmented at or before this one (this one without a stride).
+    const std::int64_t segmented = current_id_ - current_id_ % options_.segment_every;
+    result = semantic_->wait_for(segmented, options_.semantic_timeout);
     report.semantic_wait_ms = milliseconds_since(start);
   }
   if (!result) result = semantic_->newest();

@@ -40,6 +40,9 @@ struct DynamicOptions {
   SemanticParams semantic;
   GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
   DynamicCullingParams culling;
+  // Segment every n-th frame (1: all); the others use the newest mask warped by the frames'
+  // homographies. Frees the network's core for local mapping in real-time runs.
+  int segment_every = 1;
   // Deterministic mode gives up on a frame's mask after this long (then runs without it).
   std::chrono::milliseconds semantic_timeout{30000};
 };

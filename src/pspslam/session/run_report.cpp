@@ -248,7 +248,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   // How the threads shared the cores (issue #18 item 1's levers), to read beside the latency.
   json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
                         {"opencv_threads", cv::getNumThreads()},
-                        {"blas_threads", blas_threads()}};
+                        {"blas_threads", blas_threads()},
+                        {"segment_every", system.dynamic.segment_every}};
   json["map"] = {{"keyframes", mapping.keyframes_in_map},
                  {"map_points", mapping.map_points},
                  {"keyframes_processed", mapping.processed_keyframes},

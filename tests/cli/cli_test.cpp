@@ -634,8 +634,8 @@ TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
   ASSERT_LT(mask_age, static_cast<std::ptrdiff_t>(names.size())) << header;
   std::vector<std::string> ages;
   for (std::string row; std::getline(timing, row);) ages.push_back(columns(row)[mask_age]);
-  EXPECT_EQ(ages, (std::vector<std::string>{"0", "1", "0", "1", "0", "1", "0", "1", "0", "1",
-                                            "0", "1"}));
+  EXPECT_EQ(ages,
+            (std::vector<std::string>{"0", "1", "0", "1", "0", "1", "0", "1", "0", "1", "0", "1"}));
   const Result bad = pspslam("run --sequence x --segment-every 0");
   EXPECT_EQ(bad.status, 2);
   EXPECT_EQ(bad.output,

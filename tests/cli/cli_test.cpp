@@ -550,9 +550,10 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
 
 // stats.json `latency`: with --realtime every processed frame has its arrival-to-pose time
 // (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
-// `scheduling`: a real-time run lowers the background threads (nice 10) and gives OpenCV one
-// thread; a deterministic run changes neither; --background-nice / --opencv-threads override.
-// Both keep BLAS on one thread.
+// `scheduling`: a real-time run lowers the background threads (nice 10), gives OpenCV one thread
+// and local BA the best 10 covisible keyframes; a deterministic run changes none of them (the
+// whole covisible window: 0); --background-nice / --opencv-threads / --local-ba-keyframes
+// override. Both keep BLAS on one thread.
 TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   const auto dir = testing::make_temp_dir("cli_latency");
   const Result synth =
@@ -582,6 +583,7 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   for (const std::string& value : live_arrivals) EXPECT_GT(std::stod(value), 0.0);
   EXPECT_EQ(live_scheduling["background_thread_nice"].get<int>(), 10);
   EXPECT_EQ(live_scheduling["opencv_threads"].get<int>(), 1);
+  EXPECT_EQ(live_scheduling["local_ba_keyframes"].get<int>(), 10);
   EXPECT_EQ(realtime["arrival_to_pose_ms"]["count"].get<int>(), processed);
   const double median = realtime["arrival_to_pose_ms"]["median"].get<double>();
   EXPECT_GT(median, 0.0);
@@ -594,15 +596,17 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_EQ(arrival_column("deterministic"), std::vector<std::string>(30, ""));
   EXPECT_EQ(scheduling["background_thread_nice"].get<int>(), 0);
   EXPECT_EQ(scheduling["opencv_threads"].get<int>(), cv::getNumThreads());
+  EXPECT_EQ(scheduling["local_ba_keyframes"].get<int>(), 0);
   // Every run keeps OpenBLAS on one thread (0: the BLAS is another one, with no threads to set).
   for (const nlohmann::json* run : {&live_scheduling, &scheduling}) {
     EXPECT_GE((*run)["blas_threads"].get<int>(), 0);
     EXPECT_LE((*run)["blas_threads"].get<int>(), 1);
   }
   const auto [chosen_latency, chosen_frames, chosen] =
-      latency("chosen", "--realtime --background-nice 3 --opencv-threads 2");
+      latency("chosen", "--realtime --background-nice 3 --opencv-threads 2 --local-ba-keyframes 0");
   EXPECT_EQ(chosen["background_thread_nice"].get<int>(), 3);
   EXPECT_EQ(chosen["opencv_threads"].get<int>(), 2);
+  EXPECT_EQ(chosen["local_ba_keyframes"].get<int>(), 0);
 }
 
 // --segment-every (issue #18's lever): only every n-th frame goes to the network; the frames

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "mapping/synthetic_world.h"
+#include "pspslam/mapping/local_bundle_adjuster.h"
 
 namespace pspslam {
 namespace {
@@ -118,6 +119,33 @@ TEST(LocalMapper, BuildsCullsAndOptimisesASyntheticMap) {
   EXPECT_LT(error_after, 0.3 * error_before)
       << "mean centre error " << error_before / compared << " -> " << error_after / compared;
   EXPECT_LT(error_after / compared, 0.01);
+}
+
+// The local BA window: the new keyframe and its best covisible keyframes, all of them by default
+// (ORB-SLAM2) or the best N; the other keyframes that see the window's points are held fixed.
+TEST(LocalMapper, LocalBundleAdjustmentWindowKeepsTheBestCovisibles) {
+  SyntheticWorld world(900, 0.35, 21);
+  PathRun run = run_path(world, 8);
+  const auto newest = run.map->keyframe(run.map->max_keyframe_id());
+  ASSERT_TRUE(newest);
+  // Keyframe 0 anchors the map: it is held fixed even inside the window.
+  const auto free_count = [](const std::vector<std::shared_ptr<KeyFrame>>& keyframes) {
+    return 1 + static_cast<int>(std::count_if(keyframes.begin(), keyframes.end(),
+                                              [](const auto& kf) { return kf->id() != 0; }));
+  };
+  const auto covisibles = newest->covisibles();
+  ASSERT_GE(covisibles.size(), 5u);
+
+  const LocalBundleAdjustmentReport all = run_local_bundle_adjustment(*run.map, newest, {});
+  EXPECT_EQ(all.local_keyframes, free_count(covisibles));
+
+  const LocalBundleAdjustmentReport capped =
+      run_local_bundle_adjustment(*run.map, newest, {}, /*max_covisibles=*/3);
+  EXPECT_EQ(capped.local_keyframes, free_count(newest->best_covisibles(3)));
+  // The covisible keyframes left out still constrain the window's points, fixed.
+  EXPECT_GE(capped.fixed_keyframes, static_cast<int>(covisibles.size()) - 3);
+  EXPECT_LT(capped.points, all.points);
+  expect_consistent(*run.map);
 }
 
 TEST(LocalMapper, CullsRedundantKeyframes) {

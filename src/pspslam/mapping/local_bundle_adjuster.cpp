@@ -1,6 +1,7 @@
 #include "pspslam/mapping/local_bundle_adjuster.h"
 
 #include <chrono>
+#include <cstdint>
 #include <mutex>
 #include <unordered_map>
 
@@ -19,7 +20,7 @@ struct LocalWindow {
   std::vector<int> keypoint_index;  // per observation
 };
 
-LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe) {
+LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe, size_t max_covisibles) {
   LocalWindow window;
   std::unordered_map<std::uint64_t, size_t> keyframe_slot;
   const auto add_keyframe = [&](const std::shared_ptr<KeyFrame>& kf, bool fixed) {
@@ -29,7 +30,8 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe) {
     window.problem.keyframes.push_back({kf->id(), kf->T_camera_world(), fixed || kf->id() == 0});
   };
   add_keyframe(keyframe, false);
-  for (const auto& neighbour : keyframe->covisibles()) {
+  for (const auto& neighbour :
+       keyframe->best_covisibles(max_covisibles == 0 ? SIZE_MAX : max_covisibles)) {
     if (!neighbour->is_bad()) add_keyframe(neighbour, false);
   }
   const size_t num_local = window.keyframes.size();
@@ -69,10 +71,11 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe) {
 
 LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
                                                         const std::shared_ptr<KeyFrame>& keyframe,
-                                                        const BaOptions& options) {
+                                                        const BaOptions& options,
+                                                        size_t max_covisibles) {
   const auto start = std::chrono::steady_clock::now();
   LocalBundleAdjustmentReport report;
-  LocalWindow window = collect_window(keyframe);
+  LocalWindow window = collect_window(keyframe, max_covisibles);
   for (const BaKeyframe& kf : window.problem.keyframes) {
     (kf.fixed ? report.fixed_keyframes : report.local_keyframes) += 1;
   }

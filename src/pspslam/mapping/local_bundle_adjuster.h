@@ -23,10 +23,12 @@ struct LocalBundleAdjustmentReport {
   BaResult result;
 };
 
-// Local keyframes: `keyframe` and its covisible keyframes. Local points: all their map points.
-// Fixed: the keyframes that observe local points without being local, and the anchor (id 0).
+// Local keyframes: `keyframe` and its covisible keyframes, the best `max_covisibles` of them
+// (0: all). Local points: all their map points. Fixed: the keyframes that observe local points
+// without being local, and the anchor (id 0).
 LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
                                                         const std::shared_ptr<KeyFrame>& keyframe,
-                                                        const BaOptions& options);
+                                                        const BaOptions& options,
+                                                        size_t max_covisibles = 0);
 
 }  // namespace pspslam

@@ -42,8 +42,8 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
     BaOptions ba_options = options_.bundle_adjustment;
     const std::function<bool()> caller_stop = ba_options.should_stop;
     ba_options.should_stop = [&] { return keyframe_waiting() || (caller_stop && caller_stop()); };
-    const LocalBundleAdjustmentReport report =
-        run_local_bundle_adjustment(*map_, keyframe, ba_options);
+    const LocalBundleAdjustmentReport report = run_local_bundle_adjustment(
+        *map_, keyframe, ba_options, static_cast<size_t>(options_.max_local_keyframes));
     ++stats_.bundle_adjustments;
     stats_.bundle_adjustments_interrupted += report.result.stopped_early;
     stats_.ba_outliers_removed += report.outliers_removed;

@@ -33,6 +33,9 @@ struct LocalMappingOptions {
   bool redundancy_needs_depth = true;
   bool cull_keyframes = true;
   BaOptions bundle_adjustment;
+  // Local BA window: the new keyframe and at most this many of its best covisible keyframes
+  // (0: all of them, as ORB-SLAM2). The rest that see the window's points are held fixed.
+  int max_local_keyframes = 0;
   // Nice increment of the local mapping thread (core/thread_priority.h; real-time runs).
   int thread_nice = 0;
 

@@ -249,7 +249,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
                         {"opencv_threads", cv::getNumThreads()},
                         {"blas_threads", blas_threads()},
-                        {"segment_every", system.dynamic.segment_every}};
+                        {"segment_every", system.dynamic.segment_every},
+                        {"local_ba_keyframes", system.local_ba_keyframes}};
   json["map"] = {{"keyframes", mapping.keyframes_in_map},
                  {"map_points", mapping.map_points},
                  {"keyframes_processed", mapping.processed_keyframes},

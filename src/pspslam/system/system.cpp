@@ -196,6 +196,7 @@ System::System(const SystemConfig& config, SystemOptions options)
   if (options.local_mapping) {
     LocalMappingOptions mapping_options;
     mapping_options.close_depth = config.camera.depth_threshold;
+    mapping_options.max_local_keyframes = options.local_ba_keyframes;
     // The BA's wall-clock budget keeps a live system responsive; a synchronous run bounds BA by
     // its iteration counts only, so its result does not depend on the machine's load.
     if (options.synchronous_local_mapping)

@@ -53,6 +53,8 @@ struct SystemOptions {
   // is tracked against, and whether a keyframe is accepted, depend on how fast this machine is
   // right now (a fast, unpaced run outruns local BA). A live camera wants false.
   bool synchronous_local_mapping = false;
+  // Local BA window size (LocalMappingOptions::max_local_keyframes; 0: every covisible one).
+  int local_ba_keyframes = 0;
   // Nice increment of the semantic, local mapping and loop closing threads (and of the global
   // BA threads loop closing starts). A live run (--realtime, a camera) sets it so that the
   // caller thread, which must track each frame before the next one arrives, gets a core when

@@ -559,10 +559,15 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   const Result synth =
       pspslam("synth --out " + (dir / "seq").string() + " --frames 30 --bodies 0 --seed 3");
   ASSERT_EQ(synth.status, 0) << synth.output;
-  const auto latency = [&](const std::string& name, const std::string& flags) {
+  // The summary says which local BA window ran.
+  const auto latency = [&](const std::string& name, const std::string& flags,
+                           const std::string& window) {
     const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
                              (dir / name).string() + " --dynamic off " + flags);
     EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find(" local BAs cut short; local BA window: " + window + "\n"),
+              std::string::npos)
+        << r.output;
     std::ifstream in(dir / name / "stats.json");
     const nlohmann::json stats = nlohmann::json::parse(in);
     return std::tuple{stats["latency"], stats["frames"].get<int>(), stats["scheduling"]};
@@ -577,7 +582,8 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
     for (std::string row; std::getline(in, row);) values.push_back(row.substr(row.rfind(',') + 1));
     return values;
   };
-  const auto [realtime, processed, live_scheduling] = latency("realtime", "--realtime");
+  const auto [realtime, processed, live_scheduling] =
+      latency("realtime", "--realtime", "the best 10 covisible keyframes");
   const std::vector<std::string> live_arrivals = arrival_column("realtime");
   ASSERT_EQ(live_arrivals.size(), static_cast<size_t>(processed));
   for (const std::string& value : live_arrivals) EXPECT_GT(std::stod(value), 0.0);
@@ -590,7 +596,8 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_GE(realtime["arrival_to_pose_ms"]["p99"].get<double>(), median);
   EXPECT_GE(realtime["arrival_to_pose_ms"]["max"].get<double>(),
             realtime["arrival_to_pose_ms"]["p99"].get<double>());
-  const auto [deterministic, frames, scheduling] = latency("deterministic", "");
+  const auto [deterministic, frames, scheduling] =
+      latency("deterministic", "", "every covisible keyframe");
   EXPECT_EQ(frames, 30);
   EXPECT_EQ(deterministic["arrival_to_pose_ms"]["count"].get<int>(), 0);
   EXPECT_EQ(arrival_column("deterministic"), std::vector<std::string>(30, ""));
@@ -603,7 +610,8 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
     EXPECT_LE((*run)["blas_threads"].get<int>(), 1);
   }
   const auto [chosen_latency, chosen_frames, chosen] =
-      latency("chosen", "--realtime --background-nice 3 --opencv-threads 2 --local-ba-keyframes 0");
+      latency("chosen", "--realtime --background-nice 3 --opencv-threads 2 --local-ba-keyframes 0",
+              "every covisible keyframe");
   EXPECT_EQ(chosen["background_thread_nice"].get<int>(), 3);
   EXPECT_EQ(chosen["opencv_threads"].get<int>(), 2);
   EXPECT_EQ(chosen["local_ba_keyframes"].get<int>(), 0);

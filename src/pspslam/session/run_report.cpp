@@ -100,18 +100,18 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                 median(stats.tracking_ms), median(stats.tracking_cpu_ms), mapping.keyframes_in_map,
                 mapping.map_points, mapping.max_queued_keyframes, mapping.local_ba_ms_total);
   out << line;
+  const std::string window =
+      system.local_ba_keyframes > 0
+          ? "the best " + std::to_string(system.local_ba_keyframes) + " covisible keyframes"
+          : "every covisible keyframe";
   std::snprintf(line, sizeof(line),
                 "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
                 "%zu fused, %zu culled, %zu BA outlier observations removed; %zu local BAs cut "
-                "short; ",
+                "short; local BA window: %s\n",
                 mapping.processed_keyframes, mapping.keyframes_culled, mapping.points_triangulated,
                 mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed,
-                mapping.local_ba_cut_short);
+                mapping.local_ba_cut_short, window.c_str());
   out << line;
-  if (system.local_ba_keyframes > 0)
-    out << "local BA window: the best " << system.local_ba_keyframes << " covisible keyframes\n";
-  else
-    out << "local BA window: every covisible keyframe\n";
   if (system.place.loop_closing) print_loop_stats(mapping, out);
   if (!input.loop_closing_note.empty())
     out << "loop closing: off (" << input.loop_closing_note << ")\n";

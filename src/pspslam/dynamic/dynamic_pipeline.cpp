@@ -80,9 +80,9 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
   return semantic_ ? semantic_mask(report) : cv::Mat();
 }
 
-void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask,
-                                     OrbFeatures& features, DynamicReport& report,
-                                     std::vector<KeypointRecord>* dropped) {
+void DynamicPipeline::remove_dynamic(const cv::Mat& depth, std::span<const float> keypoint_depths,
+                                     const cv::Mat& semantic_mask, OrbFeatures& features,
+                                     DynamicReport& report, std::vector<KeypointRecord>* dropped) {
   geometry_mask_.release();
   picture_.regions.release();
   picture_.tested.clear();
@@ -100,6 +100,7 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, const cv::Mat& semant
     input.depth = depth;
     input.T_world_camera = *prior_pose();
     input.keypoints = pixels_;
+    input.keypoint_depths = keypoint_depths;
     input.references = views_;
     // The stage maps each keypoint back through the flow step's H into the previous mask, so
     // the mask needs no full-image warp here.

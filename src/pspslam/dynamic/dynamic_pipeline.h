@@ -7,6 +7,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "pspslam/camera/pinhole_camera.h"
@@ -112,10 +113,12 @@ class DynamicPipeline {
   cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report);
 
   // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
-  // `dropped` (null unless pictures are asked for) receives each removed keypoint with the
-  // verdict that removed it.
-  void remove_dynamic(const cv::Mat& depth, const cv::Mat& semantic_mask, OrbFeatures& features,
-                      DynamicReport& report, std::vector<KeypointRecord>* dropped = nullptr);
+  // `keypoint_depths`: each keypoint's own depth measurement (FrameBuilder::keypoint_depths;
+  // empty: the geometry stage reads `depth` at the keypoint's pixel). `dropped` (null unless
+  // pictures are asked for) receives each removed keypoint with the verdict that removed it.
+  void remove_dynamic(const cv::Mat& depth, std::span<const float> keypoint_depths,
+                      const cv::Mat& semantic_mask, OrbFeatures& features, DynamicReport& report,
+                      std::vector<KeypointRecord>* dropped = nullptr);
 
   // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
   // culled, and the geometry stage takes its reference views from the map's keyframes since

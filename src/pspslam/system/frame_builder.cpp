@@ -52,7 +52,12 @@ class RgbdFrameBuilder final : public FrameBuilder {
 // reference views and the culler reads depth where map points project. It is computed by
 // semi-global matching (cv::StereoSGBM) only when a dynamic pipeline asks for it; tracking uses
 // the sparse, sub-pixel keypoint depths, which are more accurate than SGBM's 1/16 px steps
-// smoothed over a block.
+// smoothed over a block. So does the geometry stage for its candidates (keypoint_depths()):
+// keypoints are corners, often on a depth edge, where block matching lends the nearer surface's
+// disparity to the farther one's pixels; a background keypoint read from SGBM then lies in front
+// of what its reference keyframes saw there, which the multi-view test takes for motion. On the
+// synthetic stereo sequence that put 14k static pixels a frame into the geometry mask (precision
+// 0.55); with the keypoints' own depths, 0.4k (0.98; docs/benchmarks.md, issue #16).
 class StereoFrameBuilder final : public FrameBuilder {
  public:
   // Twice the left image's features on the right: the quadtree keeps a different subset of
@@ -107,6 +112,11 @@ class StereoFrameBuilder final : public FrameBuilder {
     });
     left_extractor_.extract(gray, mask, features);
     right.get();
+    // Matched once, before dynamic removal, so the geometry stage can use the depths too.
+    match_stereo(features.keypoints, features.descriptors, right_features_.keypoints,
+                 right_features_.descriptors, gray, frame.right, *pyramid_, camera_->bf, matching_,
+                 depths_);
+    extracted_ = features.keypoints;
   }
 
   cv::Mat depth_image(const RgbdFrame& frame) override {
@@ -114,22 +124,42 @@ class StereoFrameBuilder final : public FrameBuilder {
     return sgbm_depth(left_gray_, frame.right);
   }
 
+  std::span<const float> keypoint_depths() const override { return depths_.depth; }
+
   Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
               const cv::Mat&) override {
-    StereoDepths depths;
-    match_stereo(features.keypoints, features.descriptors, right_features_.keypoints,
-                 right_features_.descriptors, left_gray_, frame.right, *pyramid_, camera_->bf,
-                 matching_, depths);
+    // The kept keypoints are an order-preserving subset of the extracted ones (dynamic removal
+    // compacts in place): walk both lists to carry each kept keypoint's match over.
+    std::vector<float> depth(features.keypoints.size());
+    std::vector<float> right_u(features.keypoints.size());
+    size_t source = 0;
+    for (size_t i = 0; i < features.keypoints.size(); ++i) {
+      const cv::KeyPoint& kept = features.keypoints[i];
+      while (source < extracted_.size() && !same_keypoint(extracted_[source], kept)) ++source;
+      if (source == extracted_.size()) {
+        throw Error("stereo camera: frame " + frame.name +
+                    " was built from keypoints that were not extracted from it");
+      }
+      depth[i] = depths_.depth[source];
+      right_u[i] = depths_.right_u[source];
+      ++source;
+    }
     return Frame(id, frame.timestamp, std::move(features.keypoints),
-                 std::move(features.descriptors), std::move(depths.depth),
-                 std::move(depths.right_u), camera_, pyramid_);
+                 std::move(features.descriptors), std::move(depth), std::move(right_u), camera_,
+                 pyramid_);
   }
 
  private:
   OrbExtractor left_extractor_;
   OrbExtractor right_extractor_;  // one per thread: an extractor keeps scratch buffers
+  static bool same_keypoint(const cv::KeyPoint& a, const cv::KeyPoint& b) {
+    return a.pt == b.pt && a.octave == b.octave && a.angle == b.angle;
+  }
+
   OrbFeatures right_features_;
-  cv::Mat left_gray_;  // of the frame being built (shared, not copied)
+  StereoDepths depths_;                  // per extracted left keypoint
+  std::vector<cv::KeyPoint> extracted_;  // the left keypoints depths_ belongs to
+  cv::Mat left_gray_;                    // of the frame being built (shared, not copied)
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   // CV_32F metres at full resolution from SGBM at half resolution (nearest-neighbour upsampling:

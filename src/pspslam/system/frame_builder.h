@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <span>
 #include <string>
 
 #include "pspslam/config/config.h"
@@ -38,8 +39,14 @@ class FrameBuilder {
   // at map points, so it must be dense. RGB-D: the sensor's image; stereo: computed here.
   virtual cv::Mat depth_image(const RgbdFrame& frame) = 0;
 
-  // The tracked frame from the features left after dynamic removal. `depth` is what
-  // depth_image() returned, or empty when no dynamic pipeline runs.
+  // Each extracted keypoint's own depth measurement (metres, <= 0: none), in extraction order,
+  // for the geometry stage's candidates; empty: the stage reads depth_image() at the keypoint's
+  // pixel (RGB-D, where that is the measurement).
+  virtual std::span<const float> keypoint_depths() const { return {}; }
+
+  // The tracked frame from the features left after dynamic removal (an order-preserving subset
+  // of the extracted ones). `depth` is what depth_image() returned, or empty when no dynamic
+  // pipeline runs.
   virtual Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
                       const cv::Mat& depth) = 0;
 

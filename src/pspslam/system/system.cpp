@@ -320,7 +320,8 @@ FrameReport System::process(const RgbdFrame& frame) {
   }
   std::vector<KeypointRecord>* fates = record_keypoint_fates_ ? &report.keypoints : nullptr;
   if (fates && record_masked_fates_) record_fates_before_removal(gray, semantic_mask, *fates);
-  dynamic_->remove_dynamic(depth, semantic_mask, features, report.dynamic, fates);
+  dynamic_->remove_dynamic(depth, frame_builder_->keypoint_depths(), semantic_mask, features,
+                           report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
   Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), depth);
   report.extraction_ms += milliseconds_since(frame_start);

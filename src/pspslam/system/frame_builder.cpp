@@ -49,15 +49,15 @@ class RgbdFrameBuilder final : public FrameBuilder {
 //
 // The dynamic pipeline needs a dense depth image (see depth_image()); sparse keypoint depths do
 // not serve it, since the geometry stage reads depth patches around *projected* pixels of its
-// reference views and the culler reads depth where map points project. It is computed by
-// semi-global matching (cv::StereoSGBM) only when a dynamic pipeline asks for it; tracking uses
-// the sparse, sub-pixel keypoint depths, which are more accurate than SGBM's 1/16 px steps
-// smoothed over a block. So does the geometry stage for its candidates (keypoint_depths()):
+// reference views and the culler reads depth where map points project. It is computed by block
+// matching (cv::StereoBM) only when a dynamic pipeline asks for it; tracking uses the sparse,
+// sub-pixel keypoint depths, which are more accurate than a dense matcher's 1/16 px steps
+// averaged over a block. So does the geometry stage for its candidates (keypoint_depths()):
 // keypoints are corners, often on a depth edge, where block matching lends the nearer surface's
-// disparity to the farther one's pixels; a background keypoint read from SGBM then lies in front
-// of what its reference keyframes saw there, which the multi-view test takes for motion. On the
-// synthetic stereo sequence that put 14k static pixels a frame into the geometry mask (precision
-// 0.55); with the keypoints' own depths, 0.4k (0.98; docs/benchmarks.md, issue #16).
+// disparity to the farther one's pixels; a background keypoint read from the dense image then
+// lies in front of what its reference keyframes saw there, which the multi-view test takes for
+// motion. On the synthetic stereo sequence that put 14k static pixels a frame into the geometry
+// mask (precision 0.55); with the keypoints' own depths, 0.4k (0.98; docs/benchmarks.md, #16).
 class StereoFrameBuilder final : public FrameBuilder {
  public:
   // Twice the left image's features on the right: the quadtree keeps a different subset of
@@ -76,17 +76,17 @@ class StereoFrameBuilder final : public FrameBuilder {
         camera_(std::move(camera)),
         pyramid_(std::move(pyramid)),
         dense_depth_(dense_depth) {
-    // SGBM runs at half resolution: its cost grows with width x height x disparities, so this
-    // is ~5x cheaper, and the dynamic pipeline's depth tests tolerate 4 cm + 4 % (geometry/).
-    // Disparities up to the nearest depth matched sparsely, rounded up to SGBM's multiple of 16,
-    // capped at 96 (nearer pixels get no depth).
+    // Block matching at half resolution: the cost grows with width x height x disparities, and
+    // the dynamic pipeline's depth tests tolerate 4 cm + 4 % (geometry/). Semi-global matching
+    // (cv::StereoSGBM, 3-way, 5x5 blocks) cost 8.5 ms a pair here against 2.8 ms, and with the
+    // candidates on their own depths it was also the less accurate of the two: on 12 synthetic
+    // stereo seeds StereoBM's runs had the lower ATE in 8 (online) and 10 (final) of 12
+    // (docs/benchmarks.md, issue #16). Disparities up to the nearest depth matched sparsely,
+    // rounded up to a multiple of 16, capped at 96 (nearer pixels get no depth); 11x11 blocks.
     const double max_disparity = 0.5 * camera_->bf / matching_.min_depth_m;
     const int disparities =
         std::clamp(static_cast<int>(std::ceil(max_disparity / 16.0)) * 16, 16, 96);
-    constexpr int kBlock = 5;
-    sgbm_ =
-        cv::StereoSGBM::create(0, disparities, kBlock, 8 * kBlock * kBlock, 32 * kBlock * kBlock, 1,
-                               0, 10, 100, 2, cv::StereoSGBM::MODE_SGBM_3WAY);
+    block_matcher_ = cv::StereoBM::create(disparities, 11);
   }
 
   void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
@@ -104,7 +104,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     // The dense depth needs only the two images: it runs beside both extractions.
     if (dense_depth_) {
       dense_ = std::async(std::launch::async, [this, left = gray, right = frame.right] {
-        return sgbm_depth(left, right);
+        return dense_depth(left, right);
       });
     }
     auto right = std::async(std::launch::async, [&] {
@@ -121,7 +121,7 @@ class StereoFrameBuilder final : public FrameBuilder {
 
   cv::Mat depth_image(const RgbdFrame& frame) override {
     if (dense_.valid()) return dense_.get();
-    return sgbm_depth(left_gray_, frame.right);
+    return dense_depth(left_gray_, frame.right);
   }
 
   std::span<const float> keypoint_depths() const override { return depths_.depth; }
@@ -162,13 +162,14 @@ class StereoFrameBuilder final : public FrameBuilder {
   cv::Mat left_gray_;                    // of the frame being built (shared, not copied)
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
-  // CV_32F metres at full resolution from SGBM at half resolution (nearest-neighbour upsampling:
-  // interpolating across a depth edge would invent depths between the two surfaces).
-  cv::Mat sgbm_depth(const cv::Mat& left, const cv::Mat& right) const {
+  // CV_32F metres at full resolution from block matching at half resolution (nearest-neighbour
+  // upsampling: interpolating across a depth edge would invent depths between the two surfaces).
+  cv::Mat dense_depth(const cv::Mat& left, const cv::Mat& right) const {
     cv::Mat left_half, right_half, disparity;
     cv::resize(left, left_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     cv::resize(right, right_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    sgbm_->compute(left_half, right_half, disparity);  // CV_16S, 16 x half-resolution disparity
+    // CV_16S, 16 x half-resolution disparity; no match: negative.
+    block_matcher_->compute(left_half, right_half, disparity);
     cv::Mat depth_half(disparity.size(), CV_32F);
     // z = bf / d_full = bf / (2 d_half) = bf * 16 / (2 * value).
     const float bf8 = static_cast<float>(camera_->bf * 8.0);
@@ -183,7 +184,7 @@ class StereoFrameBuilder final : public FrameBuilder {
   }
 
   StereoMatchOptions matching_;
-  cv::Ptr<cv::StereoSGBM> sgbm_;
+  cv::Ptr<cv::StereoBM> block_matcher_;
   bool dense_depth_ = false;
   std::future<cv::Mat> dense_;
 };

@@ -11,6 +11,10 @@
 namespace pspslam {
 namespace {
 
+bool same_keypoint(const cv::KeyPoint& a, const cv::KeyPoint& b) {
+  return a.pt == b.pt && a.octave == b.octave && a.angle == b.angle;
+}
+
 class RgbdFrameBuilder final : public FrameBuilder {
  public:
   RgbdFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
@@ -80,7 +84,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     // the dynamic pipeline's depth tests tolerate 4 cm + 4 % (geometry/). Semi-global matching
     // (cv::StereoSGBM, 3-way, 5x5 blocks) cost 8.5 ms a pair here against 2.8 ms, and with the
     // candidates on their own depths it was also the less accurate of the two: on 12 synthetic
-    // stereo seeds StereoBM's runs had the lower ATE in 8 (online) and 10 (final) of 12
+    // stereo seeds StereoBM's runs had the lower ATE in 9 (online) and 10 (final) of 12
     // (docs/benchmarks.md, issue #16). Disparities up to the nearest depth matched sparsely,
     // rounded up to a multiple of 16, capped at 96 (nearer pixels get no depth); 11x11 blocks.
     const double max_disparity = 0.5 * camera_->bf / matching_.min_depth_m;
@@ -152,10 +156,6 @@ class StereoFrameBuilder final : public FrameBuilder {
  private:
   OrbExtractor left_extractor_;
   OrbExtractor right_extractor_;  // one per thread: an extractor keeps scratch buffers
-  static bool same_keypoint(const cv::KeyPoint& a, const cv::KeyPoint& b) {
-    return a.pt == b.pt && a.octave == b.octave && a.angle == b.angle;
-  }
-
   OrbFeatures right_features_;
   StereoDepths depths_;                  // per extracted left keypoint
   std::vector<cv::KeyPoint> extracted_;  // the left keypoints depths_ belongs to

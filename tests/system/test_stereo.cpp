@@ -29,6 +29,20 @@ SynthOptions stereo_room(size_t frames, int bodies) {
   return options;
 }
 
+// Frame i as the stereo camera delivers it (colour left, grey right); `rendered` keeps the
+// rendering, ground-truth labels included.
+RgbdFrame stereo_frame(const SyntheticScene& scene, size_t i, SynthFrame& rendered) {
+  scene.render(i, rendered, 1);
+  RgbdFrame frame;
+  frame.index = i;
+  frame.timestamp = scene.timestamp(i);
+  frame.bgr = rendered.bgr;
+  cv::Mat right;
+  scene.render_right(i, right, 1);
+  cv::cvtColor(right, frame.right, cv::COLOR_BGR2GRAY);
+  return frame;
+}
+
 // Stereo through the System: every frame tracked from the rendered pair alone (no depth image),
 // within a centimetre of the ground truth, and the map's points carry stereo depth.
 TEST(Stereo, TracksAShortStaticSyntheticPairSequenceWithinOneCentimetre) {
@@ -42,15 +56,7 @@ TEST(Stereo, TracksAShortStaticSyntheticPairSequenceWithinOneCentimetre) {
   Trajectory estimate;
   SynthFrame rendered;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
-    scene.render(i, rendered, 1);
-    RgbdFrame frame;
-    frame.index = i;
-    frame.timestamp = scene.timestamp(i);
-    frame.bgr = rendered.bgr;
-    cv::Mat right;
-    scene.render_right(i, right, 1);
-    cv::cvtColor(right, frame.right, cv::COLOR_BGR2GRAY);
-    const FrameReport report = system.process(frame);
+    const FrameReport report = system.process(stereo_frame(scene, i, rendered));
     ASSERT_TRUE(report.tracking.T_world_camera.has_value()) << "frame " << i << " lost";
     estimate.push_back({scene.timestamp(i), *report.tracking.T_world_camera});
   }
@@ -76,15 +82,7 @@ TEST(Stereo, GeometryMaskStaysOnThePeople) {
   SynthFrame rendered;
   double on_people = 0.0, on_static = 0.0, people = 0.0;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
-    scene.render(i, rendered, 1);
-    RgbdFrame frame;
-    frame.index = i;
-    frame.timestamp = scene.timestamp(i);
-    frame.bgr = rendered.bgr;
-    cv::Mat right;
-    scene.render_right(i, right, 1);
-    cv::cvtColor(right, frame.right, cv::COLOR_BGR2GRAY);
-    const FrameReport report = system.process(frame);
+    const FrameReport report = system.process(stereo_frame(scene, i, rendered));
     ASSERT_TRUE(report.tracking.T_world_camera.has_value()) << "frame " << i << " lost";
     const cv::Mat mask = system.last_dynamic_mask();
     const cv::Mat person = rendered.labels != kSynthLabelStatic;

@@ -100,6 +100,33 @@ def bonn_frames(step=4):
     return names[::step]
 
 
+SYNTH_PERSON_LABEL = 15  # `pspslam synth` mask/*.png: 0 static, 15 person, 100 carried box
+
+
+def synth_frames(sequence, step):
+    """Every step-th frame of a `pspslam synth` sequence: (colour path, mask path) pairs."""
+    sequence = Path(sequence)
+
+    def listed(name):
+        lines = (sequence / name).read_text().splitlines()
+        return [sequence / line.split()[1] for line in lines
+                if line.strip() and not line.startswith("#")]
+
+    colour, masks = listed("rgb.txt"), listed("mask.txt")
+    if len(colour) != len(masks):
+        raise ValueError(f"{sequence}: {len(colour)} colour frames but {len(masks)} masks")
+    return list(zip(colour, masks))[::step]
+
+
+def load_synth_frame(colour, mask):
+    """Rendered frame (BGR) and its person mask (bool); a carried box is not a person."""
+    image = cv2.imread(str(colour), cv2.IMREAD_COLOR)
+    labels = cv2.imread(str(mask), cv2.IMREAD_UNCHANGED)
+    if image is None or labels is None:
+        raise FileNotFoundError(f"synthetic frame {colour} or its mask {mask} is missing")
+    return image, labels == SYNTH_PERSON_LABEL
+
+
 def person_iou(labels, mask):
     pred = labels == PERSON
     union = np.logical_or(pred, mask).sum()

@@ -1,4 +1,6 @@
-"""Person IoU on the human_seg validation split for segmenter metadata YAMLs.
+"""Person IoU on the human_seg validation split for segmenter metadata YAMLs, and with
+--synth on `pspslam synth` sequences against their rendered person masks (pooled over every
+--synth-step-th frame of each sequence).
 
 Uses cv2.dnn with the same preprocessing as the C++ OnnxSegmenter (stretch to the
 network input, bilinear; (p - mean) / std; arg-max; nearest-neighbour resize back),
@@ -32,6 +34,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("models", nargs="+", help="metadata YAML files")
     parser.add_argument("--threads", type=int, default=2, help="OpenCV threads")
+    parser.add_argument("--synth", nargs="*", default=[], help="`pspslam synth` sequence folders")
+    parser.add_argument("--synth-step", type=int, default=12)
     args = parser.parse_args()
     cv2.setNumThreads(args.threads)
     ids = common.load_split()["val"]
@@ -50,6 +54,20 @@ def main():
             ious.append(common.person_iou(labels, gt))
         print(f"{meta['name']:34s} {w}x{h}  person IoU {np.mean(ious):.4f} "
               f"({len(ids)} validation photos)  median forward {1000 * np.median(times):.0f} ms")
+        for sequence in args.synth:
+            frames = common.synth_frames(sequence, args.synth_step)
+            inter = union = 0
+            for colour, mask in frames:
+                bgr, gt = common.load_synth_frame(colour, mask)
+                net.setInput(common.to_blob(bgr, w, h, meta["input"]["mean"],
+                                            meta["input"]["std"]))
+                labels = cv2.resize(net.forward()[0].argmax(0).astype(np.uint8),
+                                    (gt.shape[1], gt.shape[0]), interpolation=cv2.INTER_NEAREST)
+                predicted = labels == common.PERSON
+                inter += int(np.logical_and(predicted, gt).sum())
+                union += int(np.logical_or(predicted, gt).sum())
+            print(f"{'':34s} {Path(sequence).name}: person IoU "
+                  f"{inter / max(union, 1):.4f} (pooled over {len(frames)} frames)")
 
 
 if __name__ == "__main__":

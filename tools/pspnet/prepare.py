@@ -1,10 +1,13 @@
 """Fixes the human_seg split and precomputes the teachers' soft targets once.
 
 Writes tools/pspnet/work/cache.npz with, for every training sample
-(human_seg training photos + every 4th bonn_crowd_dev frame + synthetic frames
-when given), the image stretched to the cache size, the ground-truth person
+(human_seg training photos + every 4th bonn_crowd_dev frame + frames of `pspslam synth`
+sequences when given), the image stretched to the cache size, the ground-truth person
 mask where there is one, and the teachers' ensemble log-probabilities (the mean of
-their log-softmax outputs) at 1/4 of the cache size (float16).
+their log-softmax outputs) at 1/4 of the cache size (float16). Synthetic frames get no
+teacher targets (zeros): their rendered ground truth is exact, and the teachers do not
+recognise the renderer's people (person IoU ~0.3), so train.py leaves them out of the
+distillation term.
 The default teachers are DeepLab v3 MobileNetV2 1.0 and ESPNetv2 s2.0 (the best person
 model in ../shared, 0.881 IoU); the two take ~18 min for the 286 samples on the 2-core
 machine, once: each sample's targets are kept in work/teacher_cache/ and reused.
@@ -72,8 +75,10 @@ def main():
     parser.add_argument("--height", type=int, default=384, help="cache image height")
     parser.add_argument("--bonn-step", type=int, default=4,
                         help="use every N-th bonn_crowd_dev frame")
-    parser.add_argument("--synth-dir", default="",
-                        help="optional folder of synthetic colour frames (*.png/*.jpg)")
+    parser.add_argument("--synth-sequences", nargs="*", default=[],
+                        help="`pspslam synth` sequence folders (colour + ground-truth masks)")
+    parser.add_argument("--synth-step", type=int, default=12,
+                        help="use every N-th frame of each synthetic sequence")
     parser.add_argument("--teachers", nargs="+",
                         default=["deeplabv3_mnv2_pascal", "espnetv2_s2.0_pascal_384x384"],
                         help="teacher names (see common.TEACHERS)")
@@ -86,10 +91,8 @@ def main():
     nets = teacher_nets(args.teachers)
     samples = [("human_seg", i) for i in split["train"]]
     samples += [("bonn", p) for p in common.bonn_frames(args.bonn_step)]
-    if args.synth_dir:
-        synth = sorted(Path(args.synth_dir).glob("*.png")) + sorted(
-            Path(args.synth_dir).glob("*.jpg"))
-        samples += [("synth", p) for p in synth]
+    for sequence in args.synth_sequences:
+        samples += [("synth", pair) for pair in common.synth_frames(sequence, args.synth_step)]
 
     w, h = args.width, args.height
     images = np.zeros((len(samples), h, w, 3), np.uint8)
@@ -98,14 +101,18 @@ def main():
     kinds = []
     start = time.time()
     for k, (kind, ref) in enumerate(samples):
-        if kind == "human_seg":
-            bgr, gt = common.load_human_seg(ref)
+        if kind in ("human_seg", "synth"):
+            bgr, gt = common.load_human_seg(ref) if kind == "human_seg" else \
+                common.load_synth_frame(*ref)
             masks[k] = cv2.resize(gt.astype(np.uint8) * 255, (w, h),
                                   interpolation=cv2.INTER_NEAREST)
         else:
             bgr = cv2.imread(str(ref), cv2.IMREAD_COLOR)
             masks[k] = 254
         images[k] = cv2.resize(bgr, (w, h), interpolation=cv2.INTER_AREA)
+        kinds.append(kind)
+        if kind == "synth":
+            continue  # no teacher targets (see above)
         # Teacher outputs are cached per sample so that an interrupted run resumes.
         key = f"{kind}_{Path(str(ref)).stem}_{'+'.join(args.teachers)}_{w}x{h}.npy"
         part = common.WORK / "teacher_cache" / key
@@ -115,7 +122,6 @@ def main():
             soft[k] = teacher_log_probs(nets, bgr, w // 4, h // 4).astype(np.float16)
             part.parent.mkdir(parents=True, exist_ok=True)
             np.save(part, soft[k])
-        kinds.append(kind)
         if k % 25 == 0:
             print(f"{k}/{len(samples)} {time.time() - start:.0f}s", flush=True)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

@@ -2,10 +2,12 @@
 teacher distillation.
 
 Loss per pixel (ignoring padding):
-  * cross-entropy on hard labels: on human_seg, GT person -> class 15 and GT
-    background -> the teachers' arg-max among the non-person classes; on frames
-    without ground truth (bonn, synthetic) the teachers' arg-max (weight --pseudo-weight);
-  * KL(teacher || student) at temperature T, times T^2 (weight --kd-weight);
+  * cross-entropy on hard labels: on human_seg and synthetic frames, GT person -> class 15
+    and GT background -> the teachers' arg-max among the non-person classes (background on
+    synthetic frames, which have no teacher targets); on frames without ground truth (bonn)
+    the teachers' arg-max (weight --pseudo-weight);
+  * KL(teacher || student) at temperature T, times T^2 (weight --kd-weight), on the frames
+    with teacher targets (not the synthetic ones);
   * optionally a soft-Jaccard person loss on the photos with GT (--iou-weight), since the
     target metric is person IoU against those masks.
 Validation person IoU (mean over the fixed validation split, at photo
@@ -133,16 +135,14 @@ def hard_labels(mask, soft, valid):
 
 
 class Validator:
-    """Person IoU over the validation photos with the C++ path's preprocessing (stretch to
-    the input with bilinear resize, arg-max, nearest-neighbour resize to the photo)."""
+    """Person IoU over validation images (BGR, GT mask pairs) with the C++ path's
+    preprocessing (stretch to the input with bilinear resize, arg-max, nearest-neighbour resize
+    to the image)."""
 
-    def __init__(self, ids, hw, mean, std):
+    def __init__(self, images, hw, mean, std):
         self.hw = hw
-        self.samples = []
-        for sample_id in ids:
-            bgr, gt = common.load_human_seg(sample_id)
-            self.samples.append((torch.from_numpy(common.to_blob(bgr, hw[1], hw[0], mean, std)),
-                                 gt))
+        self.samples = [(torch.from_numpy(common.to_blob(bgr, hw[1], hw[0], mean, std)), gt)
+                        for bgr, gt in images]
 
     def __call__(self, model, device):
         model.eval()
@@ -199,6 +199,12 @@ def main():
                         help="stop after the epoch that passes this wall time")
     parser.add_argument("--initial-eval", action="store_true",
                         help="also log the validation IoU before training")
+    parser.add_argument("--resume", default="",
+                        help="start from this checkpoint's weights (fine-tuning) instead of --init")
+    parser.add_argument("--synth-val", nargs="*", default=[],
+                        help="`pspslam synth` sequences never trained on: their person IoU is "
+                             "logged beside the photos' (every --synth-val-step-th frame)")
+    parser.add_argument("--synth-val-step", type=int, default=12)
     parser.add_argument("--out", default=str(common.WORK / "pspnet.pt"), help="checkpoint")
     parser.add_argument("--log", default=str(common.MODEL_DIR / "training_log.txt"),
                         help="per-epoch log file")
@@ -226,14 +232,25 @@ def main():
     model = PSPNet(hw, args.width_multiplier, branch_channels=args.branch_channels,
                    head_channels=args.head_channels, last_dilation=args.last_dilation,
                    **ARCHITECTURES[args.arch])
-    n_init = load_backbone_from_onnx(model, args.init)
+    if args.resume:
+        model.load_state_dict(torch.load(args.resume)["model"])
+        origin = f"all weights from {Path(args.resume).name} (fine-tuning)"
+    else:
+        origin = (f"backbone initialised from {Path(args.init).name} "
+                  f"({load_backbone_from_onnx(model, args.init)} conv layers)")
     model.to(device)
     backbone, head = model.param_groups()
     opt = torch.optim.AdamW([{"params": backbone, "lr": args.backbone_lr},
                              {"params": head, "lr": args.lr}], weight_decay=1e-4)
     base_lrs = [args.backbone_lr, args.lr]
     aug = Augmenter(cache, hw, device, gen)
-    validate = Validator(split["val"], hw, common.MEAN, common.STD)
+    # Synthetic frames have no teacher targets: no distillation term there.
+    has_teacher = torch.tensor([kind != "synth" for kind in kinds], device=device)
+    validate = Validator([common.load_human_seg(i) for i in split["val"]], hw, common.MEAN,
+                         common.STD)
+    synth_val = [common.load_synth_frame(*pair) for sequence in args.synth_val
+                 for pair in common.synth_frames(sequence, args.synth_val_step)]
+    validate_synth = Validator(synth_val, hw, common.MEAN, common.STD) if synth_val else None
     n = len(kinds)
     steps_per_epoch = n // args.batch
     total_steps = steps_per_epoch * args.epochs
@@ -257,10 +274,16 @@ def main():
         f"{split['seed']}, {len(split['val'])} validation photos never trained on), "
         f"{kinds.count('bonn')} bonn_crowd_dev frames, {kinds.count('synth')} synthetic frames; "
         f"teachers {list(cache['teachers'])}")
-    say(f"# backbone initialised from {Path(args.init).name} ({n_init} conv layers); "
-        f"params {sum(p.numel() for p in model.parameters())}")
+    say(f"# {origin}; params {sum(p.numel() for p in model.parameters())}")
+
+    def validation_text():
+        text = f" val_person_iou {validate(model, device):.4f}"
+        if validate_synth:
+            text += f" val_synth_person_iou {validate_synth(model, device):.4f}"
+        return text
+
     if args.initial_eval:
-        say(f"epoch 0 val_person_iou {validate(model, device):.4f}")
+        say(f"epoch 0{validation_text()}")
     start = time.time()
     step = 0
     T = args.temperature
@@ -286,7 +309,8 @@ def main():
             log_p = F.log_softmax(logits / T, 1)
             q = F.softmax(soft / T, 1)
             kd_map = (q * (torch.log(q.clamp(min=1e-8)) - log_p)).sum(1)
-            kd = (kd_map * valid).sum() / valid.sum().clamp(min=1) * T * T
+            kd_valid = valid & has_teacher[torch.as_tensor(idx, device=device)][:, None, None]
+            kd = (kd_map * kd_valid).sum() / kd_valid.sum().clamp(min=1) * T * T
             loss = ce + args.kd_weight * kd
             soft_iou_loss = torch.zeros((), device=device)
             gt_photo = (has_gt & valid).flatten(1).any(1)
@@ -316,9 +340,9 @@ def main():
         last = epoch == args.epochs or (time.time() - start) / 60 > args.max_minutes
         text = ""
         if epoch % args.eval_every == 0 or last:
-            iou = validate(model, device)
+            text = validation_text()
+            iou = float(text.split()[1])
             best = max(best, iou)
-            text = f" val_person_iou {iou:.4f}"
         say(f"epoch {epoch} loss {m['loss']:.4f} ce {m['ce']:.4f} kd {m['kd']:.4f} "
             f"soft_iou_loss {m['iou']:.4f}{text} epoch_s {time.time() - epoch_start:.1f} "
             f"total_s {time.time() - start:.0f}")

@@ -66,6 +66,36 @@ TEST(RunStatistics, CountsLostFramesRelocalisationsAndTheReturnAfterABlackout) {
   EXPECT_EQ(stats.frames_without_mask, 0u);
 }
 
+TEST(RunStatistics, FindsTheLongestLostStretchAfterTheMapStarted) {
+  RunStatistics stats(DynamicMode::full, std::nullopt);
+  FrameReport before_map;  // not initialised: not a lost stretch
+  stats.add_frame(0, before_map, 0.0);
+  stats.add_frame(1, frame(true, TrackingMethod::kInitialization), 0.0);
+  stats.add_frame(2, frame(false), 0.0);
+  stats.add_frame(3, frame(false), 0.0);
+  stats.add_frame(4, frame(true), 0.0);
+  EXPECT_EQ(stats.lost_stretches(), 1u);
+  ASSERT_TRUE(stats.longest_lost_stretch());
+  EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 2u);
+  EXPECT_EQ(stats.longest_lost_stretch()->frames, 2u);
+  EXPECT_FALSE(stats.longest_lost_stretch_until_end());
+  for (size_t i = 5; i < 8; ++i) stats.add_frame(i, frame(false), 0.0);
+  EXPECT_EQ(stats.lost_stretches(), 2u);
+  EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 5u);
+  EXPECT_EQ(stats.longest_lost_stretch()->last_frame, 7u);
+  EXPECT_EQ(stats.longest_lost_stretch()->frames, 3u);
+  EXPECT_TRUE(stats.longest_lost_stretch_until_end());
+  stats.add_frame(8, frame(true, TrackingMethod::kRelocalisation), 0.0);
+  EXPECT_FALSE(stats.longest_lost_stretch_until_end());
+  EXPECT_EQ(stats.lost_stretches(), 2u);
+
+  RunStatistics never_lost(DynamicMode::full, std::nullopt);
+  never_lost.add_frame(0, frame(true, TrackingMethod::kInitialization), 0.0);
+  EXPECT_EQ(never_lost.lost_stretches(), 0u);
+  EXPECT_FALSE(never_lost.longest_lost_stretch());
+  EXPECT_FALSE(never_lost.longest_lost_stretch_until_end());
+}
+
 TEST(StartWatch, WarnsOnceAfterTheGivenFramesAndSaysWhy) {
   StartWatch watch(3);
   TrackResult waiting;

@@ -132,6 +132,17 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
     }
     out << line;
   }
+  if (const auto longest = stats.longest_lost_stretch()) {
+    const size_t stretches = stats.lost_stretches();
+    std::snprintf(line, sizeof(line),
+                  "lost:         %zu stretch%s after the map started; the longest: frames "
+                  "%zu-%zu (%zu frames), %s\n",
+                  stretches, stretches == 1 ? "" : "es", longest->first_frame, longest->last_frame,
+                  longest->frames,
+                  stats.longest_lost_stretch_until_end() ? "until the end (never tracked again)"
+                                                         : "then tracked again");
+    out << line;
+  }
   out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
       << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
   std::optional<AteResult> ate_tracked;
@@ -223,6 +234,14 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                          {"tracked_since_initialisation", stats.tracked_since_initialisation()},
                          {"map_restarts", stats.map_restarts()}};
   }
+  nlohmann::ordered_json longest_lost = nullptr;
+  if (const auto longest = stats.longest_lost_stretch()) {
+    longest_lost = {{"first_frame", longest->first_frame},
+                    {"last_frame", longest->last_frame},
+                    {"frames", longest->frames},
+                    {"until_end", stats.longest_lost_stretch_until_end()}};
+  }
+  json["lost_stretches"] = {{"count", stats.lost_stretches()}, {"longest", longest_lost}};
   json["realtime_dropped_frames"] = stats.realtime_dropped();
   // How the input ended: a camera that was unplugged or fell silent says so here.
   json["input"] = {{"dropped_frames", source.dropped},

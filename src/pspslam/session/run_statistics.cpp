@@ -70,6 +70,20 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     if (result.T_world_camera) ++tracked_since_initialisation_;
   }
   if (result.restart_due) ++map_restarts_;
+  if (result.state == TrackingState::kLost && !result.T_world_camera) {
+    if (!current_lost_) {
+      current_lost_ = LostStretch{index, index, 0};
+      ++lost_stretches_;
+    }
+    current_lost_->last_frame = index;
+    ++current_lost_->frames;
+    if (!longest_lost_ || current_lost_->frames > longest_lost_->frames ||
+        current_lost_->first_frame == longest_lost_->first_frame) {
+      longest_lost_ = current_lost_;
+    }
+  } else {
+    current_lost_.reset();
+  }
 
   if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
   extraction_ms.push_back(report.extraction_ms);

@@ -732,6 +732,14 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   ASSERT_EQ(blackout.status, 0) << blackout.output;
   const nlohmann::json restarted = nlohmann::json::parse(read_text(dir / "b" / "stats.json"));
   EXPECT_EQ(restarted["monocular"]["map_restarts"], 1) << blackout.output;
+  // The black frames lose the first map: one stretch, ended by the new map, in the summary too.
+  EXPECT_EQ(restarted["lost_stretches"]["count"], 1) << blackout.output;
+  EXPECT_EQ(restarted["lost_stretches"]["longest"]["first_frame"], started + 2);
+  EXPECT_EQ(restarted["lost_stretches"]["longest"]["end"], "map_restarted");
+  EXPECT_TRUE(contains(blackout.output,
+                       "lost:         1 stretch after the map started; the longest: frames " +
+                           std::to_string(started + 2) + "-"))
+      << blackout.output;
   EXPECT_GT(restarted["monocular"]["initialised_at_frame"].get<int>(), started + 11);
   EXPECT_EQ(restarted["monocular"]["tracked_since_initialisation"],
             restarted["monocular"]["frames_since_initialisation"]);

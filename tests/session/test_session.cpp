@@ -78,22 +78,21 @@ TEST(RunStatistics, FindsTheLongestLostStretchAfterTheMapStarted) {
   ASSERT_TRUE(stats.longest_lost_stretch());
   EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 2u);
   EXPECT_EQ(stats.longest_lost_stretch()->frames, 2u);
-  EXPECT_FALSE(stats.longest_lost_stretch_until_end());
+  EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::tracked_again);
   for (size_t i = 5; i < 8; ++i) stats.add_frame(i, frame(false), 0.0);
   EXPECT_EQ(stats.lost_stretches(), 2u);
   EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 5u);
   EXPECT_EQ(stats.longest_lost_stretch()->last_frame, 7u);
   EXPECT_EQ(stats.longest_lost_stretch()->frames, 3u);
-  EXPECT_TRUE(stats.longest_lost_stretch_until_end());
-  stats.add_frame(8, frame(true, TrackingMethod::kRelocalisation), 0.0);
-  EXPECT_FALSE(stats.longest_lost_stretch_until_end());
+  EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::still_lost);
+  stats.add_frame(8, before_map, 0.0);  // a monocular map started again
+  EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::map_restarted);
   EXPECT_EQ(stats.lost_stretches(), 2u);
 
   RunStatistics never_lost(DynamicMode::full, std::nullopt);
   never_lost.add_frame(0, frame(true, TrackingMethod::kInitialization), 0.0);
   EXPECT_EQ(never_lost.lost_stretches(), 0u);
   EXPECT_FALSE(never_lost.longest_lost_stretch());
-  EXPECT_FALSE(never_lost.longest_lost_stretch_until_end());
 }
 
 TEST(StartWatch, WarnsOnceAfterTheGivenFramesAndSaysWhy) {

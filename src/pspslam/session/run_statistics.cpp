@@ -81,7 +81,12 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
         current_lost_->first_frame == longest_lost_->first_frame) {
       longest_lost_ = current_lost_;
     }
-  } else {
+  } else if (current_lost_) {
+    // A frame with a pose ends the stretch, or the first frame of a new map (monocular restart).
+    if (longest_lost_->first_frame == current_lost_->first_frame) {
+      longest_lost_->end =
+          result.T_world_camera ? LostStretch::End::tracked_again : LostStretch::End::map_restarted;
+    }
     current_lost_.reset();
   }
 

@@ -60,19 +60,16 @@ class RunStatistics {
   size_t processed_since_initialisation() const { return processed_since_initialisation_; }
   size_t map_restarts() const { return map_restarts_; }
   // Consecutive frames lost after the map existed (frames before it started do not count):
-  // how many such stretches, and the longest (the first of equal length). A stretch that
-  // reaches the last processed frame was never tracked again.
+  // how many such stretches, and the longest (the first of equal length) with how it ended.
   struct LostStretch {
+    enum class End { still_lost, tracked_again, map_restarted };
     size_t first_frame = 0;
     size_t last_frame = 0;
     size_t frames = 0;
+    End end = End::still_lost;  // still_lost: it reaches the last frame processed
   };
   size_t lost_stretches() const { return lost_stretches_; }
   std::optional<LostStretch> longest_lost_stretch() const { return longest_lost_; }
-  bool longest_lost_stretch_until_end() const {
-    return current_lost_ && longest_lost_ &&
-           current_lost_->first_frame == longest_lost_->first_frame;
-  }
 
   std::vector<double> extraction_ms;
   std::vector<double> tracking_ms;

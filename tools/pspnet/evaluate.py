@@ -30,6 +30,18 @@ def load_net(meta_file):
     return meta, cv2.dnn.readNetFromONNX(str(path))
 
 
+def network_labels(net, meta, bgr):
+    """Arg-max labels at the network's input size (the C++ path's preprocessing)."""
+    net.setInput(common.to_blob(bgr, meta["input"]["width"], meta["input"]["height"],
+                                meta["input"]["mean"], meta["input"]["std"]))
+    return net.forward()[0].argmax(0).astype(np.uint8)
+
+
+def at_size_of(labels, image):
+    """Labels resized (nearest neighbour) to the size of `image`."""
+    return cv2.resize(labels, (image.shape[1], image.shape[0]), interpolation=cv2.INTER_NEAREST)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("models", nargs="+", help="metadata YAML files")
@@ -46,12 +58,9 @@ def main():
         for sample_id in ids:
             bgr, gt = common.load_human_seg(sample_id)
             t0 = time.perf_counter()
-            net.setInput(common.to_blob(bgr, w, h, meta["input"]["mean"], meta["input"]["std"]))
-            labels = net.forward()[0].argmax(0).astype(np.uint8)
+            labels = network_labels(net, meta, bgr)
             times.append(time.perf_counter() - t0)
-            labels = cv2.resize(labels, (gt.shape[1], gt.shape[0]),
-                                interpolation=cv2.INTER_NEAREST)
-            ious.append(common.person_iou(labels, gt))
+            ious.append(common.person_iou(at_size_of(labels, gt), gt))
         print(f"{meta['name']:34s} {w}x{h}  person IoU {np.mean(ious):.4f} "
               f"({len(ids)} validation photos)  median forward {1000 * np.median(times):.0f} ms")
         for sequence in args.synth:
@@ -59,11 +68,7 @@ def main():
             inter = union = 0
             for colour, mask in frames:
                 bgr, gt = common.load_synth_frame(colour, mask)
-                net.setInput(common.to_blob(bgr, w, h, meta["input"]["mean"],
-                                            meta["input"]["std"]))
-                labels = cv2.resize(net.forward()[0].argmax(0).astype(np.uint8),
-                                    (gt.shape[1], gt.shape[0]), interpolation=cv2.INTER_NEAREST)
-                predicted = labels == common.PERSON
+                predicted = at_size_of(network_labels(net, meta, bgr), gt) == common.PERSON
                 inter += int(np.logical_and(predicted, gt).sum())
                 union += int(np.logical_or(predicted, gt).sum())
             print(f"{'':34s} {Path(sequence).name}: person IoU "

@@ -276,14 +276,16 @@ def main():
         f"teachers {list(cache['teachers'])}")
     say(f"# {origin}; params {sum(p.numel() for p in model.parameters())}")
 
-    def validation_text():
-        text = f" val_person_iou {validate(model, device):.4f}"
+    def validation():
+        """The photos' person IoU, and the log text with the rendered frames' beside it."""
+        photos = validate(model, device)
+        text = f" val_person_iou {photos:.4f}"
         if validate_synth:
             text += f" val_synth_person_iou {validate_synth(model, device):.4f}"
-        return text
+        return photos, text
 
     if args.initial_eval:
-        say(f"epoch 0{validation_text()}")
+        say(f"epoch 0{validation()[1]}")
     start = time.time()
     step = 0
     T = args.temperature
@@ -340,8 +342,7 @@ def main():
         last = epoch == args.epochs or (time.time() - start) / 60 > args.max_minutes
         text = ""
         if epoch % args.eval_every == 0 or last:
-            text = validation_text()
-            iou = float(text.split()[1])
+            iou, text = validation()
             best = max(best, iou)
         say(f"epoch {epoch} loss {m['loss']:.4f} ce {m['ce']:.4f} kd {m['kd']:.4f} "
             f"soft_iou_loss {m['iou']:.4f}{text} epoch_s {time.time() - epoch_start:.1f} "

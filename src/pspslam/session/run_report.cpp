@@ -77,28 +77,22 @@ nlohmann::ordered_json report_blackout(const RunReportInput& input, const FrameR
       {"after_return_max_m", after_return ? after_return->max : -1.0}};
 }
 
-const char* to_string(RunStatistics::LostStretch::End end) {
-  switch (end) {
-    case RunStatistics::LostStretch::End::still_lost:
-      return "still_lost";
-    case RunStatistics::LostStretch::End::tracked_again:
-      return "tracked_again";
-    case RunStatistics::LostStretch::End::map_restarted:
-      return "map_restarted";
-  }
-  return "?";
-}
+// How a lost stretch ended: its stats.json name and the summary's words.
+struct LostStretchEnding {
+  const char* name;
+  const char* words;
+};
 
-const char* describe(RunStatistics::LostStretch::End end) {
+LostStretchEnding ending(RunStatistics::LostStretch::End end) {
   switch (end) {
     case RunStatistics::LostStretch::End::still_lost:
-      return "until the end (never tracked again)";
+      return {"still_lost", "until the end (never tracked again)"};
     case RunStatistics::LostStretch::End::tracked_again:
-      return "then tracked again";
+      return {"tracked_again", "then tracked again"};
     case RunStatistics::LostStretch::End::map_restarted:
-      return "then a new map was started";
+      return {"map_restarted", "then a new map was started"};
   }
-  return "?";
+  return {"?", "?"};
 }
 
 }  // namespace
@@ -162,7 +156,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                   "lost:         %zu stretch%s after the map started; the longest: frames "
                   "%zu-%zu (%zu frames), %s\n",
                   stretches, stretches == 1 ? "" : "es", longest->first_frame, longest->last_frame,
-                  longest->frames, describe(longest->end));
+                  longest->frames, ending(longest->end).words);
     out << line;
   }
   out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
@@ -261,7 +255,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
     longest_lost = {{"first_frame", longest->first_frame},
                     {"last_frame", longest->last_frame},
                     {"frames", longest->frames},
-                    {"end", to_string(longest->end)}};
+                    {"end", ending(longest->end).name}};
   }
   json["lost_stretches"] = {{"count", stats.lost_stretches()}, {"longest", longest_lost}};
   json["realtime_dropped_frames"] = stats.realtime_dropped();

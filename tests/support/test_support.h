@@ -15,7 +15,9 @@ bool shared_required();
 
 // A fresh, empty temporary directory unique to the running test and process: ctest runs each
 // test of a suite in its own process, in parallel, and a suite-level fixture (no current test)
-// must not share its folder with the same suite's other processes.
+// must not share its folder with the same suite's other processes. The folder is removed when the
+// test (or, for a suite fixture, the program) ends without a failure; a failure keeps it and
+// prints its path, and PSPSLAM_KEEP_TEST_DIRS=1 keeps every folder.
 std::filesystem::path make_temp_dir(const std::string& tag);
 
 // Runs a shell command, returns its exit status; stdout+stderr land in *output.

@@ -655,6 +655,33 @@ TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
             "'pspslam run --help')\n");
 }
 
+// Monocular loop closing (issue #16): a colour-only run around a synthetic loop (1.25 turns in
+// 480 frames, static room) closes the loop with a similarity, says by how much it resized the
+// map, and the final trajectory gains from it. Measured once each: final ATE 7.3 mm with loop
+// closing, 12.2 mm with --loop-closing off; online 9.9 / 12.9 mm.
+TEST(CliRun, MonocularLoopIsClosedWithASimilarity) {
+  const auto dir = testing::make_temp_dir("cli_mono_loop");
+  const Result synth = pspslam("synth --out " + (dir / "seq").string() +
+                               " --frames 480 --bodies 0 --trajectory loop --loop-turns 1.25 "
+                               "--seed 1");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const auto out = dir / "out";
+  const Result run = pspslam("run --sequence " + (dir / "seq").string() +
+                             " --sensor monocular --dynamic off --out " + out.string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "loop closing: on\n")) << run.output;
+  EXPECT_TRUE(contains(run.output, " closed (last moved its keyframe ")) << run.output;
+  EXPECT_TRUE(contains(run.output, " map units, resized it x")) << run.output;
+  const nlohmann::json stats = nlohmann::json::parse(read_text(out / "stats.json"));
+  EXPECT_GE(stats["loops"]["closed"].get<int>(), 1);
+  const double resized = stats["loops"]["last_correction"]["resized"].get<double>();
+  EXPECT_GT(resized, 0.8);
+  EXPECT_LT(resized, 1.25);
+  EXPECT_NE(resized, 1.0) << "a monocular loop must estimate its scale";
+  EXPECT_GE(stats["monocular"]["tracked_since_initialisation"].get<int>(), 470) << run.output;
+  EXPECT_LT(stats["ate_refined"]["rmse"].get<double>(), 0.010) << run.output;
+}
+
 // --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own
 // encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
 // 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
@@ -685,9 +712,10 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   EXPECT_TRUE(contains(
       run.output, "video:        " + (dir / "seq.avi").string() + " (file, 120 frames, 30 fps"))
       << run.output;
-  EXPECT_TRUE(
-      contains(run.output, "loop closing: off (monocular: Sim(3) correction not implemented)"))
-      << run.output;
+  // Monocular loops are closed with a similarity (Sim(3)); a map without a metric unit reports
+  // its corrections in map units.
+  EXPECT_TRUE(contains(run.output, "loop closing: on\n")) << run.output;
+  EXPECT_TRUE(contains(run.output, "loops:        0 closed, ")) << run.output;
   const Trajectory trajectory = read_tum_trajectory(out / "trajectory.txt");
   // The map starts within the first 30 frames and every frame after is tracked.
   ASSERT_GE(trajectory.size(), 90u) << run.output;

@@ -3,7 +3,8 @@
 // estimated poses drift (a yaw and translation bias per keyframe), and, as in a real run, when
 // it comes back to the start tracking only knows the recent keyframes' points, so the revisited
 // wall gets duplicate map points. The loop must be found only on the revisit, after three
-// consistent keyframes, and its correction must pull the drifted keyframes back.
+// consistent keyframes, and its correction must pull the drifted keyframes back. The monocular
+// world also drifts in scale and its keyframes have no depth: the loop is a similarity there.
 
 #include <gtest/gtest.h>
 
@@ -36,7 +37,8 @@ struct Landmark {
 
 class LoopWorld {
  public:
-  explicit LoopWorld(std::uint32_t seed) : rng_(seed) {
+  explicit LoopWorld(std::uint32_t seed, bool monocular = false)
+      : rng_(seed), monocular_(monocular) {
     camera_ = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(CameraConfig{}, 0.08));
     pyramid_ = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
     std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
@@ -73,6 +75,39 @@ class LoopWorld {
     return (drift * true_pose(k).inverse()).inverse();
   }
 
+  // Monocular drift: the same, and the map shrinks by 0.5 % per keyframe. D_k maps the true
+  // world into keyframe k's estimated world; the camera sees the same rays with depths scaled by
+  // s_k, so its estimated pose is the rigid Sim3(s_k) · T_true · D_k⁻¹ (scale s_k · 1 / s_k).
+  static double monocular_scale(int k) { return std::pow(0.995, k); }
+  static Sim3 monocular_drift(int k) {
+    Sim3 drift(drifted_pose(k) * true_pose(k).inverse());
+    drift.scale = monocular_scale(k);
+    return drift;
+  }
+  static Pose monocular_pose(int k) {
+    const Sim3 depth_scale(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
+                           monocular_scale(k));
+    return (depth_scale * true_pose(k) * monocular_drift(k).inverse()).rescaled_pose();
+  }
+  Pose estimated_pose(int k) const { return monocular_ ? monocular_pose(k) : drifted_pose(k); }
+
+  // Median over the keyframe's map points of (depth in the keyframe) / (true depth): the scale
+  // of the map around it.
+  double depth_ratio(const KeyFrame& keyframe) const {
+    const int k = static_cast<int>(keyframe.id());
+    const std::vector<int>& landmark_of = landmarks_seen_by_.at(k);
+    std::vector<double> ratios;
+    for (int i = 0; i < keyframe.size(); ++i) {
+      const auto point = keyframe.map_point(i);
+      if (!point || point->is_bad()) continue;
+      const double depth = (keyframe.T_camera_world() * point->position()).z();
+      ratios.push_back(depth / (true_pose(k) * landmarks_[landmark_of[i]].position).z());
+    }
+    if (ratios.empty()) return 0.0;
+    std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+    return ratios[ratios.size() / 2];
+  }
+
   // Builds keyframe k as tracking + local mapping would: associations with the points of the
   // last three keyframes only (the local map), new points from depth for the rest, observations,
   // covisibility, BoW and database entry.
@@ -99,8 +134,10 @@ class LoopWorld {
       descriptors.push_back(landmarks_[i].descriptor);
       landmark_of.push_back(i);
     }
-    Frame frame(static_cast<std::uint64_t>(k), k, keypoints, descriptors, depth, camera_, pyramid_);
-    frame.set_pose(drifted_pose(k));
+    landmarks_seen_by_[k] = landmark_of;
+    Frame frame(static_cast<std::uint64_t>(k), k, keypoints, descriptors,
+                monocular_ ? cv::Mat() : depth, camera_, pyramid_);
+    frame.set_pose(estimated_pose(k));
     for (size_t j = 0; j < landmark_of.size(); ++j) {
       const auto found = local_points_.find(landmark_of[j]);
       if (found != local_points_.end() && !found->second.point->is_bad() &&
@@ -113,8 +150,11 @@ class LoopWorld {
     for (int j = 0; j < keyframe->size(); ++j) {
       auto point = keyframe->map_point(j);
       if (!point) {
-        point = std::make_shared<MapPoint>(map.next_map_point_id(), keyframe->unproject_world(j),
-                                           keyframe);
+        // Monocular: where triangulation in the drifted map would have put it.
+        const Eigen::Vector3d position =
+            monocular_ ? monocular_drift(k) * landmarks_[landmark_of[j]].position
+                       : keyframe->unproject_world(j);
+        point = std::make_shared<MapPoint>(map.next_map_point_id(), position, keyframe);
         keyframe->add_map_point(j, point);
         map.add_map_point(point);
         local_points_[landmark_of[j]] = {point, k};
@@ -140,10 +180,12 @@ class LoopWorld {
     int keyframe = 0;  // last keyframe that saw it
   };
   std::mt19937 rng_;
+  bool monocular_ = false;
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   std::vector<Landmark> landmarks_;
   std::map<int, LocalPoint> local_points_;
+  std::map<int, std::vector<int>> landmarks_seen_by_;  // keyframe -> landmark of each keypoint
 };
 
 double center_error(const Pose& a, const Pose& b) {
@@ -183,7 +225,8 @@ TEST(LoopDetection, SyntheticLoopIsFoundOnRevisitAndCorrected) {
   // matched keyframe (whose own drift is small): compare both relative poses.
   const Pose true_relative =
       LoopWorld::true_pose(detected_at) * LoopWorld::true_pose(matched).inverse();
-  const Pose estimated_relative = loop->T_current_matched;
+  EXPECT_EQ(loop->S_current_matched.scale, 1.0) << "RGB-D: depth fixes the scale";
+  const Pose estimated_relative = loop->S_current_matched.rescaled_pose();
   EXPECT_LT((true_relative.translation() - estimated_relative.translation()).norm(), 0.03);
 
   const double error_before =
@@ -283,6 +326,64 @@ TEST(LoopDetection, KeyframesAreBackOnTheTruthAfterCorrectionAndGlobalBa) {
   EXPECT_LT(rms(adjusted), 0.0035)
       << "global BA: " << rms(drifted) << " -> " << rms(adjusted) << " m RMS";
   EXPECT_LT(worst, 0.006) << "worst keyframe after the global BA: " << worst << " m";
+}
+
+// Monocular: the loop keyframes disagree in scale as well (the map shrank by 0.5 % per keyframe).
+// Detection must estimate that scale, and the Sim(3) correction with Sim(3) essential graph must
+// bring the current keyframe back and its neighbourhood back to the loop side's scale.
+TEST(LoopDetection, MonocularLoopIsASimilarityAndItsScaleIsCorrected) {
+  const auto place = PlaceRecognition::load(default_vocabulary_path());
+  Map map;
+  LoopWorld world(11, /*monocular=*/true);
+  LoopDetectorOptions options;  // as the monocular FrameBuilder sets them (system/)
+  options.ransac.estimate_scale = true;
+  options.ransac_error_base = 0.0;
+  options.ransac_error_per_depth = 0.03;
+  options.ransac_error_per_depth2 = 0.0;
+  LoopDetector detector(map, *place, options);
+  std::optional<DetectedLoop> loop;
+  int detected_at = -1;
+  const int last = kKeyframesPerTurn * 3 / 2;
+  for (int k = 0; k <= last && !loop; ++k) {
+    const auto keyframe = world.add_keyframe(k, map, *place);
+    const auto candidates = detector.detect(keyframe);
+    if (candidates.empty()) continue;
+    loop = detector.verify(keyframe, candidates);
+    if (loop) detected_at = k;
+  }
+  ASSERT_TRUE(loop.has_value()) << "no loop; consistent candidates "
+                                << detector.stats().consistent_candidates << ", rejected "
+                                << detector.stats().rejected_geometry;
+  EXPECT_GE(detected_at, kKeyframesPerTurn + 1);
+  EXPECT_LE(detected_at, kKeyframesPerTurn + 6);
+  const int matched = static_cast<int>(loop->matched->id());
+  // Current camera coordinates are s_current / s_matched times the matched ones.
+  const double true_scale =
+      LoopWorld::monocular_scale(detected_at) / LoopWorld::monocular_scale(matched);
+  EXPECT_NEAR(loop->S_current_matched.scale, true_scale, 0.01)
+      << "keyframes " << detected_at << " and " << matched;
+
+  const double error_before =
+      center_error(loop->current->T_camera_world(), LoopWorld::true_pose(detected_at));
+  const double depth_ratio_before = world.depth_ratio(*loop->current);
+  LoopEdges edges;
+  LoopCorrectionOptions correction;
+  correction.pose_graph.optimize_scale = true;
+  const LoopCorrectionReport report = correct_loop(map, *loop, edges, correction, {});
+  ASSERT_TRUE(report.graph.usable);
+  EXPECT_NEAR(report.correction_scale, 1.0 / loop->S_current_world.scale, 1e-12);
+  const double error_after =
+      center_error(loop->current->T_camera_world(), LoopWorld::true_pose(detected_at));
+  RecordProperty("error_before_mm", static_cast<int>(1000 * error_before));
+  RecordProperty("error_after_mm", static_cast<int>(1000 * error_after));
+  EXPECT_GT(error_before, 0.15) << "the synthetic drift should be large";
+  EXPECT_LT(error_after, 0.25 * error_before)
+      << "before " << error_before << " m, after " << error_after << " m";
+  // The corrected neighbourhood is at the loop side's scale: the current keyframe sees its points
+  // at the true depths times the matched keyframe's scale (0.99), no longer about its own (0.88:
+  // its points were made by the keyframes just before it, at 0.88-0.90).
+  EXPECT_NEAR(depth_ratio_before, LoopWorld::monocular_scale(detected_at), 0.03);
+  EXPECT_NEAR(world.depth_ratio(*loop->current), LoopWorld::monocular_scale(matched), 0.02);
 }
 
 TEST(LoopDetection, NoLoopBeforeTheRevisit) {

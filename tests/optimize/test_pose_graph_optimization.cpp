@@ -50,11 +50,18 @@ std::vector<Pose> dead_reckoning(const std::vector<Pose>& truth, std::vector<Pos
   return estimate;
 }
 
+PoseGraphNode node(std::uint64_t id, const Pose& T_camera_world, bool fixed) {
+  return {id, Sim3(T_camera_world), fixed};
+}
+
+// The camera pose a node stands for (its similarity rescaled to the world's units).
+Pose pose_of(const PoseGraphNode& node) { return node.S_camera_world.rescaled_pose(); }
+
 double max_position_error(const std::vector<Pose>& truth, const PoseGraph& graph) {
   double worst = 0.0;
   for (size_t i = 0; i < truth.size(); ++i) {
-    worst = std::max(
-        worst, translation_error(graph.nodes[i].T_camera_world.inverse(), truth[i].inverse()));
+    worst =
+        std::max(worst, translation_error(pose_of(graph.nodes[i]).inverse(), truth[i].inverse()));
   }
   return worst;
 }
@@ -63,7 +70,7 @@ double max_position_error(const std::vector<Pose>& truth, const PoseGraph& graph
 double rms_position_error(const std::vector<Pose>& truth, const PoseGraph& graph) {
   double sum = 0.0;
   for (size_t i = 0; i < truth.size(); ++i) {
-    const double e = translation_error(graph.nodes[i].T_camera_world.inverse(), truth[i].inverse());
+    const double e = translation_error(pose_of(graph.nodes[i]).inverse(), truth[i].inverse());
     sum += e * e;
   }
   return std::sqrt(sum / static_cast<double>(truth.size()));
@@ -80,17 +87,17 @@ TEST(PoseGraphOptimization, DriftCorruptedLoopIsClosed) {
 
   PoseGraph graph;
   for (int i = 0; i < kPoses; ++i)
-    graph.nodes.push_back({static_cast<std::uint64_t>(i), drifted[i], i == 0});
+    graph.nodes.push_back(node(static_cast<std::uint64_t>(i), drifted[i], i == 0));
   for (int i = 0; i + 1 < kPoses; ++i)
-    graph.edges.push_back({static_cast<size_t>(i), static_cast<size_t>(i + 1), steps[i]});
-  graph.edges.push_back({kPoses - 1, 0, truth[kPoses - 1] * truth[0].inverse()});
+    graph.edges.push_back({static_cast<size_t>(i), static_cast<size_t>(i + 1), Sim3(steps[i])});
+  graph.edges.push_back({kPoses - 1, 0, Sim3(truth[kPoses - 1] * truth[0].inverse())});
 
   const double before = rms_position_error(truth, graph);
   const double end_before = translation_error(drifted.back().inverse(), truth.back().inverse());
   const PoseGraphResult result = optimize_pose_graph(graph);
   const double after = rms_position_error(truth, graph);
   const double end_after =
-      translation_error(graph.nodes.back().T_camera_world.inverse(), truth.back().inverse());
+      translation_error(pose_of(graph.nodes.back()).inverse(), truth.back().inverse());
 
   ASSERT_TRUE(result.usable);
   EXPECT_LT(result.final_cost, 0.01 * result.initial_cost);
@@ -101,7 +108,7 @@ TEST(PoseGraphOptimization, DriftCorruptedLoopIsClosed) {
   EXPECT_LT(after, 0.6 * before) << "before " << before << " m, after " << after << " m";
   EXPECT_GT(end_before, 0.1);
   EXPECT_LT(end_after, 0.02) << "the loop edge is exact: the end must land on the start";
-  EXPECT_NEAR(graph.nodes[0].T_camera_world.translation().x(), truth[0].translation().x(), 1e-12)
+  EXPECT_NEAR(pose_of(graph.nodes[0]).translation().x(), truth[0].translation().x(), 1e-12)
       << "the fixed node must not move";
 }
 
@@ -114,28 +121,80 @@ TEST(PoseGraphOptimization, ExactEdgesRecoverGroundTruth) {
   const std::vector<Pose> drifted = dead_reckoning(truth, steps, rng, 1.0);
   PoseGraph graph;
   for (int i = 0; i < kPoses; ++i)
-    graph.nodes.push_back({static_cast<std::uint64_t>(i), drifted[i], false});
+    graph.nodes.push_back(node(static_cast<std::uint64_t>(i), drifted[i], false));
   for (int i = 0; i + 1 < kPoses; ++i) {
-    graph.edges.push_back(
-        {static_cast<size_t>(i), static_cast<size_t>(i + 1), truth[i] * truth[i + 1].inverse()});
+    graph.edges.push_back({static_cast<size_t>(i), static_cast<size_t>(i + 1),
+                           Sim3(truth[i] * truth[i + 1].inverse())});
   }
-  graph.edges.push_back({kPoses - 1, 0, truth[kPoses - 1] * truth[0].inverse()});
+  graph.edges.push_back({kPoses - 1, 0, Sim3(truth[kPoses - 1] * truth[0].inverse())});
   // No fixed node: the first one becomes the gauge, and it starts at the truth.
   const PoseGraphResult result = optimize_pose_graph(graph);
   ASSERT_TRUE(result.usable);
   EXPECT_LT(max_position_error(truth, graph), 1e-4);
   for (int i = 0; i < kPoses; ++i) {
-    EXPECT_LT(rotation_error_deg(graph.nodes[i].T_camera_world, truth[i]), 0.01) << "pose " << i;
+    EXPECT_LT(rotation_error_deg(pose_of(graph.nodes[i]), truth[i]), 0.01) << "pose " << i;
   }
+}
+
+// Monocular odometry drifts in scale: every step's measured similarity shrinks the map by 1 %
+// (and carries the usual noise), so by the end of the loop the map is 25 % smaller and the last
+// camera is far from the first. The loop edge says how the last keyframe truly sits relative to
+// the first, scale included. With Sim(3) nodes the optimiser spreads the scale error over the
+// loop; SE(3) nodes cannot absorb it and leave most of the error in place.
+TEST(PoseGraphOptimization, ScaleDriftIsSpreadOverTheLoopBySimilarityNodes) {
+  constexpr int kPoses = 30;
+  const std::vector<Pose> truth = circle_poses(kPoses);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  constexpr double kShrinkPerStep = 0.99;
+  std::vector<Sim3> estimate{Sim3(truth[0])};
+  std::vector<Sim3> steps;
+  for (int i = 0; i + 1 < kPoses; ++i) {
+    const Pose jitter =
+        make_pose(radians(0.05) * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)),
+                  0.002 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+    // S_i_(i+1): the true relative pose, its translation seen at the map's current scale.
+    Sim3 step(truth[i] * truth[i + 1].inverse() * jitter);
+    step.scale = kShrinkPerStep;
+    steps.push_back(step);
+    estimate.push_back(step.inverse() * estimate.back());
+  }
+  const auto graph_with = [&](const std::vector<Sim3>& nodes) {
+    PoseGraph graph;
+    for (int i = 0; i < kPoses; ++i)
+      graph.nodes.push_back({static_cast<std::uint64_t>(i), nodes[i], i == 0});
+    for (int i = 0; i + 1 < kPoses; ++i)
+      graph.edges.push_back({static_cast<size_t>(i), static_cast<size_t>(i + 1), steps[i]});
+    graph.edges.push_back({kPoses - 1, 0, Sim3(truth[kPoses - 1] * truth[0].inverse())});
+    return graph;
+  };
+  PoseGraph similarity = graph_with(estimate);
+  const double before = rms_position_error(truth, similarity);
+  PoseGraphOptions options;
+  options.optimize_scale = true;
+  ASSERT_TRUE(optimize_pose_graph(similarity, options).usable);
+  const double after = rms_position_error(truth, similarity);
+  PoseGraph rigid = graph_with(estimate);
+  ASSERT_TRUE(optimize_pose_graph(rigid).usable);
+  const double after_rigid = rms_position_error(truth, rigid);
+  RecordProperty("rms_before_mm", static_cast<int>(1000 * before));
+  RecordProperty("rms_sim3_mm", static_cast<int>(1000 * after));
+  RecordProperty("rms_se3_mm", static_cast<int>(1000 * after_rigid));
+  EXPECT_GT(before, 0.2) << "the synthetic scale drift should be large";
+  EXPECT_LT(after, 0.1 * before) << "Sim(3): " << before << " -> " << after << " m RMS";
+  EXPECT_LT(after, 0.5 * after_rigid) << "SE(3) nodes reach " << after_rigid << " m RMS";
+  // The loop's last keyframe is back at its true scale (the loop edge measured scale 1).
+  EXPECT_NEAR(similarity.nodes[kPoses - 1].S_camera_world.scale, 1.0, 0.02);
+  EXPECT_EQ(similarity.nodes[0].S_camera_world.scale, 1.0) << "the fixed node keeps its scale";
 }
 
 TEST(PoseGraphOptimization, RejectsBadEdges) {
   PoseGraph graph;
-  graph.nodes.push_back({0, Pose::Identity(), true});
-  graph.nodes.push_back({1, Pose::Identity(), false});
-  graph.edges.push_back({0, 2, Pose::Identity()});
+  graph.nodes.push_back(node(0, Pose::Identity(), true));
+  graph.nodes.push_back(node(1, Pose::Identity(), false));
+  graph.edges.push_back({0, 2, Sim3()});
   EXPECT_THROW(optimize_pose_graph(graph), Error);
-  graph.edges = {{1, 1, Pose::Identity()}};
+  graph.edges = {{1, 1, Sim3()}};
   EXPECT_THROW(optimize_pose_graph(graph), Error);
 }
 

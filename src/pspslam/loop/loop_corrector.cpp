@@ -23,39 +23,46 @@ LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges&
   const auto& current = loop.current;
   std::lock_guard lock(map.update_mutex());
 
-  // 1. Poses of the current keyframe's neighbourhood, moved rigidly with it.
+  // 1. The current keyframe's neighbourhood moves with it: S_i_world' = T_i_current ·
+  // S_current_world' (ORB-SLAM2 CorrectLoop). On a monocular map the similarity also rescales the
+  // neighbourhood to the loop side's units; its keyframes take the rescaled poses and its points
+  // p' = S_i_world'⁻¹ · T_i_world · p, which keeps every projection as it was.
   current->update_connections();
   std::vector<std::shared_ptr<KeyFrame>> connected = current->covisibles();
   connected.push_back(current);
   std::unordered_set<std::uint64_t> connected_ids;
   for (const auto& keyframe : connected) connected_ids.insert(keyframe->id());
   std::unordered_map<std::uint64_t, Pose> uncorrected;  // T_camera_world before the loop
-  std::unordered_map<std::uint64_t, Pose> corrected;
+  std::unordered_map<std::uint64_t, Sim3> corrected;    // S_camera_world after it
   const Pose T_world_current = current->T_world_camera();
   for (const auto& keyframe : connected) {
     const Pose T_camera_world = keyframe->T_camera_world();
     uncorrected[keyframe->id()] = T_camera_world;
-    corrected[keyframe->id()] = (T_camera_world * T_world_current) * loop.T_current_world;
+    corrected[keyframe->id()] = Sim3(T_camera_world * T_world_current) * loop.S_current_world;
   }
   {
-    const Pose change = loop.T_current_world * T_world_current;
+    const Pose corrected_current = loop.S_current_world.rescaled_pose();
+    const Pose change = corrected_current * T_world_current;
     report.correction_m =
-        (loop.T_current_world.inverse().translation() - T_world_current.translation()).norm();
+        (corrected_current.inverse().translation() - T_world_current.translation()).norm();
     report.correction_deg = Eigen::AngleAxisd(change.linear()).angle() * 180.0 / M_PI;
+    report.correction_scale = 1.0 / loop.S_current_world.scale;
   }
   // Each point moves with the first neighbourhood keyframe that sees it; remembered so that the
   // final point correction uses the same keyframe.
   std::unordered_map<std::uint64_t, std::uint64_t> corrected_by;
   for (const auto& keyframe : connected) {
-    const Pose world_change =
-        corrected.at(keyframe->id()).inverse() * uncorrected.at(keyframe->id());
+    const Pose& before = uncorrected.at(keyframe->id());
+    const Sim3 after_inverse = corrected.at(keyframe->id()).inverse();
     for (const auto& point : keyframe->map_points()) {
       if (!point || point->is_bad() || corrected_by.contains(point->id())) continue;
       corrected_by[point->id()] = keyframe->id();
-      point->set_position(world_change * point->position());
+      point->set_position(after_inverse * (before * point->position()));
     }
   }
-  for (const auto& keyframe : connected) keyframe->set_pose(corrected.at(keyframe->id()));
+  for (const auto& keyframe : connected) {
+    keyframe->set_pose(corrected.at(keyframe->id()).rescaled_pose());
+  }
   for (const auto& keyframe : connected) {
     for (const auto& point : keyframe->map_points()) {
       if (point) point->update_normal_and_depth(keyframe->pyramid());
@@ -107,25 +114,28 @@ LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges&
     node_of[keyframe->id()] = graph.nodes.size();
     keyframes.push_back(keyframe);
     // The loop keyframe is held fixed (gauge), as in ORB-SLAM2.
+    const auto moved = corrected.find(keyframe->id());
     graph.nodes.push_back(
-        {keyframe->id(), keyframe->T_camera_world(), keyframe->id() == loop.matched->id()});
+        {keyframe->id(),
+         moved != corrected.end() ? moved->second : Sim3(keyframe->T_camera_world()),
+         keyframe->id() == loop.matched->id()});
   }
   // Relative measurements use the poses before the correction where the neighbourhood moved:
   // odometry inside the neighbourhood is unchanged, only the loop links carry the correction.
   const auto measured_pose = [&](std::uint64_t id, std::size_t node) {
     const auto it = uncorrected.find(id);
-    return it != uncorrected.end() ? it->second : graph.nodes[node].T_camera_world;
+    return it != uncorrected.end() ? Sim3(it->second) : graph.nodes[node].S_camera_world;
   };
   std::set<std::pair<std::size_t, std::size_t>> inserted;
   const auto add_edge = [&](std::size_t a, std::size_t b, bool use_corrected) {
     if (a == b) return;
     const auto key = std::minmax(a, b);
     if (!inserted.insert(key).second) return;
-    const Pose T_a =
-        use_corrected ? graph.nodes[a].T_camera_world : measured_pose(graph.nodes[a].id, a);
-    const Pose T_b =
-        use_corrected ? graph.nodes[b].T_camera_world : measured_pose(graph.nodes[b].id, b);
-    graph.edges.push_back({a, b, T_a * T_b.inverse()});
+    const Sim3 S_a =
+        use_corrected ? graph.nodes[a].S_camera_world : measured_pose(graph.nodes[a].id, a);
+    const Sim3 S_b =
+        use_corrected ? graph.nodes[b].S_camera_world : measured_pose(graph.nodes[b].id, b);
+    graph.edges.push_back({a, b, S_a * S_b.inverse()});
   };
   for (const auto& [id, others] : loop_connections) {
     const auto a = node_of.find(id);
@@ -165,10 +175,10 @@ LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges&
   report.graph_edges = graph.edges.size();
 
   // 6. Keyframes take the optimised poses; points move with the keyframe they were corrected by
-  // (or their reference keyframe), keeping their position in that camera.
+  // (or their reference keyframe), keeping their place in that camera: p' = S_after⁻¹ S_before p.
   if (report.graph.usable) {
     for (std::size_t n = 0; n < keyframes.size(); ++n) {
-      keyframes[n]->set_pose(graph.nodes[n].T_camera_world);
+      keyframes[n]->set_pose(graph.nodes[n].S_camera_world.rescaled_pose());
     }
     for (const auto& point : map.map_points()) {
       if (point->is_bad()) continue;
@@ -182,8 +192,8 @@ LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges&
       }
       const auto node = node_of.find(anchor_id);
       if (node == node_of.end()) continue;
-      const Pose& before = before_optimisation[node->second].T_camera_world;
-      const Pose& after = graph.nodes[node->second].T_camera_world;
+      const Sim3& before = before_optimisation[node->second].S_camera_world;
+      const Sim3& after = graph.nodes[node->second].S_camera_world;
       point->set_position(after.inverse() * (before * point->position()));
       if (const auto reference = point->reference_keyframe()) {
         point->update_normal_and_depth(reference->pyramid());

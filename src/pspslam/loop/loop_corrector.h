@@ -1,8 +1,9 @@
 #pragma once
 
-// Loop correction (ORB-SLAM2 LoopClosing::CorrectLoop, scale fixed for RGB-D): moves the current
-// keyframe's neighbourhood to where the loop says it is, fuses the duplicated map points, adds
-// the loop edges and spreads the loop error over the map with an essential-graph optimisation.
+// Loop correction (ORB-SLAM2 LoopClosing::CorrectLoop): moves the current keyframe's
+// neighbourhood to where the loop's similarity says it is (rescaled too on a monocular map),
+// fuses the duplicated map points, adds the loop edges and spreads the loop error over the map
+// with an essential-graph optimisation (Sim(3) nodes when pose_graph.optimize_scale).
 //
 // The caller stops local mapping first (it must not create or cull keyframes meanwhile) and
 // releases it afterwards. correct_loop() takes Map::update_mutex() for its whole duration, so
@@ -41,9 +42,10 @@ struct LoopCorrectionReport {
   std::size_t graph_keyframes = 0;
   std::size_t graph_edges = 0;
   PoseGraphResult graph;
-  double correction_m = 0.0;    // how far the current keyframe moved
-  double correction_deg = 0.0;  // and turned
-  double seconds = 0.0;         // wall time with Map::update_mutex() held
+  double correction_m = 0.0;      // how far the current keyframe moved
+  double correction_deg = 0.0;    // and turned
+  double correction_scale = 1.0;  // and how its neighbourhood was resized (monocular)
+  double seconds = 0.0;           // wall time with Map::update_mutex() held
 };
 
 LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges& loop_edges,

@@ -161,38 +161,38 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
   correspondences.reserve(pairs.size());
   for (const PointPair& pair : pairs) {
     const double z = std::max(pair.in_current.z(), pair.in_candidate.z());
-    correspondences.push_back(
-        {pair.in_candidate, pair.in_current,
-         options_.ransac_error_base + options_.ransac_error_per_depth2 * z * z});
+    correspondences.push_back({pair.in_candidate, pair.in_current,
+                               options_.ransac_error_base + options_.ransac_error_per_depth * z +
+                                   options_.ransac_error_per_depth2 * z * z});
   }
   RigidRansacOptions ransac = options_.ransac;
   ransac.seed = keyframe->id() * 7919 + candidate->id();
   const RigidRansacResult estimate = solve_rigid_ransac(correspondences, ransac);
   if (!estimate.success) return std::nullopt;
-  Pose T_current_candidate = estimate.T_target_source;
+  Sim3 S_current_candidate = estimate.S_target_source;
 
   // 2. Guided search for more pairs, then refinement on the pairs that reproject in both
   // images (the role of ORB-SLAM2's OptimizeSim3), with weights 1/z² (depth noise).
   for (size_t k = 0; k < pairs.size(); ++k) {
     if (!estimate.inlier[k]) matched[pairs[k].index] = nullptr;
   }
-  match_by_transform(*keyframe, *candidate, T_current_candidate, matched, options_.guided_radius,
+  match_by_transform(*keyframe, *candidate, S_current_candidate, matched, options_.guided_radius,
                      options_.matching);
   pairs = point_pairs(*keyframe, *candidate, matched);
   std::vector<std::uint8_t> inlier(pairs.size(), 0);
   int inliers = 0;
   for (int round = 0; round < 3; ++round) {
-    const Pose T_candidate_current = T_current_candidate.inverse();
+    const Sim3 S_candidate_current = S_current_candidate.inverse();
     inliers = 0;
     std::vector<Eigen::Vector3d> source;
     std::vector<Eigen::Vector3d> target;
     std::vector<double> weights;
     for (size_t k = 0; k < pairs.size(); ++k) {
       const PointPair& pair = pairs[k];
-      inlier[k] = reprojects(*keyframe, pair.index, T_current_candidate * pair.in_candidate,
+      inlier[k] = reprojects(*keyframe, pair.index, S_current_candidate * pair.in_candidate,
                              options_.reprojection_chi2) &&
                   reprojects(*candidate, pair.candidate_index,
-                             T_candidate_current * pair.in_current, options_.reprojection_chi2);
+                             S_candidate_current * pair.in_current, options_.reprojection_chi2);
       if (!inlier[k]) continue;
       ++inliers;
       source.push_back(pair.in_candidate);
@@ -201,9 +201,15 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
       weights.push_back(1.0 / std::max(z * z, 0.01));
     }
     if (inliers < options_.min_verified_inliers) return std::nullopt;
-    const std::optional<Pose> refined = align_rigid(source, target, weights);
-    if (!refined) return std::nullopt;
-    T_current_candidate = *refined;
+    if (options_.ransac.estimate_scale) {
+      const std::optional<Sim3> refined = align_similarity(source, target, weights);
+      if (!refined) return std::nullopt;
+      S_current_candidate = *refined;
+    } else {
+      const std::optional<Pose> refined = align_rigid(source, target, weights);
+      if (!refined) return std::nullopt;
+      S_current_candidate = Sim3(*refined);
+    }
   }
   for (size_t k = 0; k < pairs.size(); ++k) {
     if (!inlier[k]) matched[pairs[k].index] = nullptr;
@@ -218,8 +224,8 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
   DetectedLoop loop;
   loop.current = keyframe;
   loop.matched = candidate;
-  loop.T_current_matched = T_current_candidate;
-  loop.T_current_world = T_current_candidate * candidate->T_camera_world();
+  loop.S_current_matched = S_current_candidate;
+  loop.S_current_world = S_current_candidate * candidate->T_camera_world();
   loop.verified_inliers = inliers;
   std::unordered_set<const MapPoint*> seen;
   auto neighbourhood = candidate->covisibles();
@@ -229,7 +235,7 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
       if (point && seen.insert(point.get()).second) loop.loop_points.push_back(point);
     }
   }
-  match_by_projection(*keyframe, loop.T_current_world, loop.loop_points, matched,
+  match_by_projection(*keyframe, loop.S_current_world.rescaled_pose(), loop.loop_points, matched,
                       options_.projection_radius, options_.matching);
   loop.total_matches = static_cast<int>(
       std::count_if(matched.begin(), matched.end(), [](const auto& p) { return p != nullptr; }));

@@ -1,8 +1,9 @@
 #pragma once
 
-// Loop detection and verification for RGB-D (ORB-SLAM2 LoopClosing::DetectLoop and
-// ComputeSim3 with the scale fixed). Synchronous; LoopClosing runs it on its thread, tests call
-// it directly.
+// Loop detection and verification (ORB-SLAM2 LoopClosing::DetectLoop and ComputeSim3): the loop
+// transform is a Sim(3) whose scale is estimated for monocular maps (scale drift) and fixed to 1
+// where depth fixes it (RGB-D, stereo). Synchronous; LoopClosing runs it on its thread, tests
+// call it directly.
 //
 //   LoopDetector detector(map, place, options);
 //   for each keyframe local mapping has finished:
@@ -34,10 +35,12 @@ struct LoopDetectorOptions {
   int consistency_threshold = 3;
   LoopMatchingOptions matching;
   int min_descriptor_matches = 20;  // candidates with fewer are not tried
-  RigidRansacOptions ransac;        // min_inliers 20, 300 iterations
-  // RANSAC inlier test in 3D, per pair: |Δ| <= base + per_depth2 · z² (z: the larger depth),
-  // because RGB-D depth noise grows with z².
+  RigidRansacOptions ransac;        // min_inliers 20, 300 iterations; estimate_scale: Sim(3)
+  // RANSAC inlier test in 3D, per pair: |Δ| <= base + per_depth · z + per_depth2 · z² (z: the
+  // larger depth, in the map's units). RGB-D depth noise grows with z² (metres); a monocular
+  // map has no unit, so its test is relative to the depth (the sensor's FrameBuilder sets it).
   double ransac_error_base = 0.02;
+  double ransac_error_per_depth = 0.0;
   double ransac_error_per_depth2 = 0.01;
   double guided_radius = 7.5;       // pixels at level 0 (SearchBySim3)
   double reprojection_chi2 = 9.21;  // 2-dof χ² at 99%, in both images
@@ -50,9 +53,10 @@ struct LoopDetectorOptions {
 struct DetectedLoop {
   std::shared_ptr<KeyFrame> current;
   std::shared_ptr<KeyFrame> matched;  // the loop keyframe (old side)
-  Pose T_current_matched = Pose::Identity();
-  // Corrected pose of the current keyframe: T_current_matched · T_matched_world.
-  Pose T_current_world = Pose::Identity();
+  Sim3 S_current_matched;             // scale 1 unless the detector estimates it (monocular)
+  // Corrected pose of the current keyframe: S_current_matched · T_matched_world, in the units of
+  // the current keyframe's map (its rescaled_pose() is the pose in the loop side's units).
+  Sim3 S_current_world;
   // Per keypoint of `current`: the loop map point matched to it (nullptr: none).
   std::vector<std::shared_ptr<MapPoint>> matched_points;
   // Map points of the matched keyframe and its covisible keyframes (fused into the current

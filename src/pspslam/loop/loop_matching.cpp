@@ -145,7 +145,7 @@ int match_by_descriptor(const KeyFrame& keyframe, const KeyFrame& candidate,
 }
 
 int match_by_transform(const KeyFrame& keyframe, const KeyFrame& candidate,
-                       const Pose& T_keyframe_candidate,
+                       const Sim3& S_keyframe_candidate,
                        std::vector<std::shared_ptr<MapPoint>>& matched, double radius,
                        const LoopMatchingOptions& options) {
   const auto own_points = keyframe.map_points();
@@ -155,12 +155,13 @@ int match_by_transform(const KeyFrame& keyframe, const KeyFrame& candidate,
     if (point) already.insert(point.get());
   }
   // Each side's points are expressed in its own camera, then moved with the loop transform:
-  // T_keyframe_world' = T_keyframe_candidate · T_candidate_world places candidate points in
-  // `keyframe`; its inverse places the keyframe's points in the candidate.
-  const Pose T_candidate_world = candidate.T_camera_world();
-  const Pose T_keyframe_world = keyframe.T_camera_world();
-  const Pose candidate_in_keyframe = T_keyframe_candidate * T_candidate_world;
-  const Pose keyframe_in_candidate = T_keyframe_candidate.inverse() * T_keyframe_world;
+  // S_keyframe_world' = S_keyframe_candidate · T_candidate_world places candidate points in
+  // `keyframe`; its inverse places the keyframe's points in the candidate. As poses rescaled to
+  // each side's world units they project and measure distances exactly as the similarities do.
+  const Pose candidate_in_keyframe =
+      (S_keyframe_candidate * candidate.T_camera_world()).rescaled_pose();
+  const Pose keyframe_in_candidate =
+      (S_keyframe_candidate.inverse() * keyframe.T_camera_world()).rescaled_pose();
   const Eigen::Vector3d keyframe_center_in_candidate_world =
       candidate_in_keyframe.inverse().translation();
   const Eigen::Vector3d candidate_center_in_keyframe_world =

@@ -1,7 +1,8 @@
 #pragma once
 
 // Matching between a keyframe and the map around a loop candidate (ORB-SLAM2 ORBmatcher's
-// SearchByBoW, SearchBySim3 and SearchByProjection with a given pose, scale fixed for RGB-D).
+// SearchByBoW, SearchBySim3 and SearchByProjection with a given pose; the loop transform is a
+// Sim(3), of scale 1 for RGB-D and stereo).
 // Results are written per keypoint of `keyframe`: matched[i] = map point matched to keypoint i
 // (nullptr: none). `matched` must have keyframe.size() entries; existing entries are kept and
 // their keypoints / map points are not matched again.
@@ -9,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "pspslam/core/similarity.h"
 #include "pspslam/core/types.h"
 
 namespace pspslam {
@@ -30,11 +32,11 @@ int match_by_descriptor(const KeyFrame& keyframe, const KeyFrame& candidate,
                         std::vector<std::shared_ptr<MapPoint>>& matched,
                         const LoopMatchingOptions& options = {});
 
-// Guided search with T_keyframe_candidate: the candidate's map points are predicted in
+// Guided search with S_keyframe_candidate: the candidate's map points are predicted in
 // `keyframe` and the keyframe's in the candidate, within radius · scale(level) pixels; only
 // mutual matches are added. Returns the number added.
 int match_by_transform(const KeyFrame& keyframe, const KeyFrame& candidate,
-                       const Pose& T_keyframe_candidate,
+                       const Sim3& S_keyframe_candidate,
                        std::vector<std::shared_ptr<MapPoint>>& matched, double radius,
                        const LoopMatchingOptions& options = {});
 

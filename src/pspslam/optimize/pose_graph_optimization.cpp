@@ -7,6 +7,7 @@
 #include <ceres/solver.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <string>
 
 #include "pspslam/core/error.h"
@@ -22,9 +23,9 @@ namespace {
 // autodiff does not produce).
 class RelativePoseError {
  public:
-  RelativePoseError(const Pose& T_first_second, double weight, double rotation_weight)
-      : measured_rotation_inverse_(Eigen::Quaterniond(T_first_second.linear()).conjugate()),
-        measured_translation_(T_first_second.translation()),
+  RelativePoseError(const Sim3& S_first_second, double weight, double rotation_weight)
+      : measured_rotation_inverse_(Eigen::Quaterniond(S_first_second.rotation).conjugate()),
+        measured_translation_(S_first_second.translation),
         weight_(weight),
         rotation_weight_(rotation_weight) {}
 
@@ -57,6 +58,54 @@ class RelativePoseError {
   double rotation_weight_;
 };
 
+// The Sim(3) form, for monocular maps (ORB-SLAM2's EdgeSim3): each node adds a log-scale block.
+// With S_i = (s_i, R_i, t_i) the prediction is S_first_second = S_first · S_second⁻¹, i.e.
+// (s_p, R_p, t_p) = (s_1 / s_2, R_1 R_2ᵀ, t_1 − s_p R_p t_2), and the error is
+// S_measured⁻¹ · S_predicted = (s_p / s_m, R_mᵀ R_p, R_mᵀ (t_p − t_m) / s_m), read as
+// r = [w_R · 2 vec(q_err); t_err; log(s_p / s_m)].
+class RelativeSimilarityError {
+ public:
+  RelativeSimilarityError(const Sim3& S_first_second, double weight, double rotation_weight)
+      : measured_rotation_inverse_(Eigen::Quaterniond(S_first_second.rotation).conjugate()),
+        measured_translation_(S_first_second.translation),
+        measured_log_scale_(std::log(S_first_second.scale)),
+        weight_(weight),
+        rotation_weight_(rotation_weight) {}
+
+  template <typename T>
+  bool operator()(const T* first, const T* first_log_scale, const T* second,
+                  const T* second_log_scale, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_first(first);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_first(first + 4);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_second(second);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_second(second + 4);
+    const T log_scale_predicted = first_log_scale[0] - second_log_scale[0];
+    const Eigen::Quaternion<T> q_predicted = q_first * q_second.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_predicted =
+        t_first - ceres::exp(log_scale_predicted) * (q_predicted * t_second);
+    const Eigen::Quaternion<T> q_measured_inverse = measured_rotation_inverse_.cast<T>();
+    Eigen::Quaternion<T> q_error = q_measured_inverse * q_predicted;
+    if (q_error.w() < T(0)) q_error.coeffs() = -q_error.coeffs();
+    const Eigen::Matrix<T, 3, 1> t_error =
+        (q_measured_inverse * (t_predicted - measured_translation_.cast<T>())) *
+        T(std::exp(-measured_log_scale_));
+    const T rotation_scale = T(2.0 * weight_ * rotation_weight_);
+    for (int k = 0; k < 3; ++k) {
+      residual[k] = rotation_scale * q_error.vec()[k];
+      residual[3 + k] = T(weight_) * t_error[k];
+    }
+    residual[6] = T(weight_) * (log_scale_predicted - T(measured_log_scale_));
+    return true;
+  }
+
+ private:
+  Eigen::Quaterniond measured_rotation_inverse_;
+  Eigen::Vector3d measured_translation_;
+  double measured_log_scale_;
+  double weight_;
+  double rotation_weight_;
+};
+
 }  // namespace
 
 PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& options) {
@@ -72,10 +121,18 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
   }
   if (graph.nodes.empty() || graph.edges.empty()) return result;
 
+  // Each node: the rotation and translation of its similarity as a pose block, and (with
+  // optimize_scale) its log scale as a block of one.
   std::vector<PoseParameters> parameters;
+  std::vector<double> log_scales;
   parameters.reserve(graph.nodes.size());
+  log_scales.reserve(graph.nodes.size());
   for (const PoseGraphNode& node : graph.nodes) {
-    parameters.push_back(PoseParameters::from_pose(node.T_camera_world));
+    Pose rigid = Pose::Identity();
+    rigid.linear() = node.S_camera_world.rotation;
+    rigid.translation() = node.S_camera_world.translation;
+    parameters.push_back(PoseParameters::from_pose(rigid));
+    log_scales.push_back(std::log(node.S_camera_world.scale));
   }
 
   ceres::Problem::Options problem_options;
@@ -84,25 +141,37 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
   ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> manifold{
       ceres::EigenQuaternionManifold(), ceres::EuclideanManifold<3>()};
   for (const PoseGraphEdge& edge : graph.edges) {
-    auto* cost = new ceres::AutoDiffCostFunction<RelativePoseError, 6, 7, 7>(
-        new RelativePoseError(edge.T_first_second, edge.weight, options.rotation_weight));
-    problem.AddResidualBlock(cost, nullptr, parameters[edge.first].data(),
-                             parameters[edge.second].data());
+    if (options.optimize_scale) {
+      auto* cost = new ceres::AutoDiffCostFunction<RelativeSimilarityError, 7, 7, 1, 7, 1>(
+          new RelativeSimilarityError(edge.S_first_second, edge.weight, options.rotation_weight));
+      problem.AddResidualBlock(cost, nullptr, parameters[edge.first].data(),
+                               &log_scales[edge.first], parameters[edge.second].data(),
+                               &log_scales[edge.second]);
+    } else {
+      auto* cost = new ceres::AutoDiffCostFunction<RelativePoseError, 6, 7, 7>(
+          new RelativePoseError(edge.S_first_second, edge.weight, options.rotation_weight));
+      problem.AddResidualBlock(cost, nullptr, parameters[edge.first].data(),
+                               parameters[edge.second].data());
+    }
   }
+  const auto hold = [&](size_t k) {
+    problem.SetParameterBlockConstant(parameters[k].data());
+    if (options.optimize_scale) problem.SetParameterBlockConstant(&log_scales[k]);
+  };
   bool any_fixed = false;
   for (size_t k = 0; k < graph.nodes.size(); ++k) {
     double* block = parameters[k].data();
     if (!problem.HasParameterBlock(block)) continue;  // a node without edges stays as it is
     problem.SetManifold(block, &manifold);
     if (graph.nodes[k].fixed) {
-      problem.SetParameterBlockConstant(block);
+      hold(k);
       any_fixed = true;
     }
   }
   if (!any_fixed) {
     for (size_t k = 0; k < graph.nodes.size(); ++k) {
       if (!problem.HasParameterBlock(parameters[k].data())) continue;
-      problem.SetParameterBlockConstant(parameters[k].data());
+      hold(k);
       break;
     }
   }
@@ -121,7 +190,11 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
   result.usable = summary.IsSolutionUsable();
   if (!result.usable) return result;
   for (size_t k = 0; k < graph.nodes.size(); ++k) {
-    if (!graph.nodes[k].fixed) graph.nodes[k].T_camera_world = parameters[k].to_pose();
+    if (graph.nodes[k].fixed) continue;
+    const Pose rigid = parameters[k].to_pose();
+    graph.nodes[k].S_camera_world = Sim3(
+        rigid.linear(), rigid.translation(),
+        options.optimize_scale ? std::exp(log_scales[k]) : graph.nodes[k].S_camera_world.scale);
   }
   return result;
 }

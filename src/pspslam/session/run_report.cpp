@@ -24,14 +24,24 @@ double median(std::vector<double> values) {
   return values[mid];
 }
 
-void print_loop_stats(const MappingStats& mapping, std::ostream& out) {
+void print_loop_stats(const MappingStats& mapping, bool monocular, std::ostream& out) {
+  // A monocular map has no metric unit: the correction is in the map's units, and the loop
+  // also resizes the neighbourhood of its keyframe (Sim(3)).
+  char last[128] = "";
+  if (mapping.loops_closed > 0 && monocular) {
+    std::snprintf(last, sizeof(last), " (last moved its keyframe %.3f map units, resized it x%.3f)",
+                  mapping.last_loop_correction_m, mapping.last_loop_correction_scale);
+  } else if (mapping.loops_closed > 0) {
+    std::snprintf(last, sizeof(last), " (last moved its keyframe %.3f m)",
+                  mapping.last_loop_correction_m);
+  }
   char line[512];
-  std::snprintf(
-      line, sizeof(line),
-      "loops:        %zu closed (last moved its keyframe %.3f m), %zu candidates rejected by "
-      "geometry; global BA %zu applied, %zu aborted (last %.2f s)\n",
-      mapping.loops_closed, mapping.last_loop_correction_m, mapping.loop_candidates_rejected,
-      mapping.global_ba_applied, mapping.global_ba_aborted, mapping.last_global_ba_seconds);
+  std::snprintf(line, sizeof(line),
+                "loops:        %zu closed%s, %zu candidates rejected by geometry; global BA %zu "
+                "applied, %zu aborted (last %.2f s)\n",
+                mapping.loops_closed, last, mapping.loop_candidates_rejected,
+                mapping.global_ba_applied, mapping.global_ba_aborted,
+                mapping.last_global_ba_seconds);
   out << line;
 }
 
@@ -130,10 +140,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                 mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed,
                 mapping.local_ba_cut_short, window.c_str());
   out << line;
-  if (system.place.loop_closing) print_loop_stats(mapping, out);
-  if (!input.loop_closing_note.empty())
-    out << "loop closing: off (" << input.loop_closing_note << ")\n";
   const bool monocular = input.sensor == SensorType::monocular;
+  if (system.place.loop_closing) print_loop_stats(mapping, monocular, out);
   if (monocular) {
     if (stats.initialised_at()) {
       const size_t since = stats.processed_since_initialisation();
@@ -297,7 +305,11 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   json["loops"] = {{"enabled", system.place.loop_closing},
                    {"closed", mapping.loops_closed},
                    {"global_ba_applied", mapping.global_ba_applied}};
-  if (!input.loop_closing_note.empty()) json["loops"]["disabled_because"] = input.loop_closing_note;
+  if (mapping.loops_closed > 0) {
+    // Map units: metres except for a monocular map; the scale is 1 except for a monocular map.
+    json["loops"]["last_correction"] = {{"moved", mapping.last_loop_correction_m},
+                                        {"resized", mapping.last_loop_correction_scale}};
+  }
   const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
       {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
   for (const auto& [key, ate] : ates) {

@@ -27,10 +27,9 @@ struct RunReportInput {
   bool interrupted = false;
   SensorType sensor = SensorType::rgbd;
   // What the sensor could not run (system/frame_builder.h apply_sensor_limits): the mode asked
-  // for, and the notes of the summary.
+  // for, and the note of the summary.
   DynamicMode requested_mode = DynamicMode::off;
   std::string dynamic_note;
-  std::string loop_closing_note;
 };
 
 // The run's summary: printed to `out` (frames, speed, map, loops, ATE against the sequence's

@@ -85,8 +85,7 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
     out_ << "map:          " << system.map_file.string()
          << (system.localization_only ? " (localisation only)" : " (extended)") << "\n";
   }
-  out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off")
-       << (limits_.loop_closing_note.empty() ? "" : " (" + limits_.loop_closing_note + ")") << "\n";
+  out_ << "loop closing: " << (system.place.loop_closing ? "on" : "off") << "\n";
   // Keypoint fates cost a second extraction per frame: only for the overlays.
   if (images_.writes_overlays()) {
     options_.system.record_keypoint_fates = true;
@@ -272,8 +271,7 @@ void SequenceRunner::finish(double seconds) {
                     .interrupted = interrupted(),
                     .sensor = input_.config.camera.type,
                     .requested_mode = limits_.requested_mode,
-                    .dynamic_note = limits_.dynamic_note,
-                    .loop_closing_note = limits_.loop_closing_note},
+                    .dynamic_note = limits_.dynamic_note},
                    out_);
 }
 

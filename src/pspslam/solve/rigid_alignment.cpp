@@ -9,7 +9,7 @@
 namespace pspslam {
 namespace {
 
-int count_inliers(std::span<const RigidCorrespondence> correspondences, const Pose& T,
+int count_inliers(std::span<const RigidCorrespondence> correspondences, const Sim3& T,
                   std::vector<std::uint8_t>* inlier) {
   int count = 0;
   for (size_t i = 0; i < correspondences.size(); ++i) {
@@ -21,23 +21,11 @@ int count_inliers(std::span<const RigidCorrespondence> correspondences, const Po
   return count;
 }
 
-std::optional<Pose> align_inliers(std::span<const RigidCorrespondence> correspondences,
-                                  const std::vector<std::uint8_t>& inlier) {
-  std::vector<Eigen::Vector3d> source;
-  std::vector<Eigen::Vector3d> target;
-  for (size_t i = 0; i < correspondences.size(); ++i) {
-    if (!inlier[i]) continue;
-    source.push_back(correspondences[i].source);
-    target.push_back(correspondences[i].target);
-  }
-  return align_rigid(source, target);
-}
-
-}  // namespace
-
-std::optional<Pose> align_rigid(std::span<const Eigen::Vector3d> source,
-                                std::span<const Eigen::Vector3d> target,
-                                std::span<const double> weights) {
+// Umeyama (1991): the rotation from the SVD of the weighted cross-covariance, then (optionally)
+// the scale trace(D·sign) / Σ w |source − mean|², then the translation between the means.
+std::optional<Sim3> align(std::span<const Eigen::Vector3d> source,
+                          std::span<const Eigen::Vector3d> target, std::span<const double> weights,
+                          bool with_scale) {
   const size_t n = source.size();
   if (n < 3 || target.size() != n || (!weights.empty() && weights.size() != n)) return std::nullopt;
   const auto weight = [&](size_t i) { return weights.empty() ? 1.0 : weights[i]; };
@@ -54,20 +42,58 @@ std::optional<Pose> align_rigid(std::span<const Eigen::Vector3d> source,
   target_mean /= total;
   // Cross-covariance Σ w (t − t̄)(s − s̄)ᵀ; R = U diag(1, 1, det(UVᵀ)) Vᵀ maximises tr(Rᵀ Σ).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double source_spread = 0.0;
   for (size_t i = 0; i < n; ++i) {
     covariance += weight(i) * (target[i] - target_mean) * (source[i] - source_mean).transpose();
+    source_spread += weight(i) * (source[i] - source_mean).squaredNorm();
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
                                               Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::Vector3d singular = svd.singularValues();
   // Rank < 2 (all points on a line or one point): the rotation about that line is free.
   if (singular(1) <= 1e-12 * std::max(1.0, singular(0))) return std::nullopt;
-  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2, 2) = -1.0;
+  Eigen::Vector3d sign = Eigen::Vector3d::Ones();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) sign(2) = -1.0;
+  Sim3 S;
+  S.rotation = svd.matrixU() * sign.asDiagonal() * svd.matrixV().transpose();
+  if (with_scale) {
+    if (source_spread <= 0.0) return std::nullopt;
+    S.scale = singular.dot(sign) / source_spread;
+    if (!(S.scale > 0.0)) return std::nullopt;
+  }
+  S.translation = target_mean - S.scale * (S.rotation * source_mean);
+  return S;
+}
+
+std::optional<Sim3> align_inliers(std::span<const RigidCorrespondence> correspondences,
+                                  const std::vector<std::uint8_t>& inlier, bool with_scale) {
+  std::vector<Eigen::Vector3d> source;
+  std::vector<Eigen::Vector3d> target;
+  for (size_t i = 0; i < correspondences.size(); ++i) {
+    if (!inlier[i]) continue;
+    source.push_back(correspondences[i].source);
+    target.push_back(correspondences[i].target);
+  }
+  return align(source, target, {}, with_scale);
+}
+
+}  // namespace
+
+std::optional<Pose> align_rigid(std::span<const Eigen::Vector3d> source,
+                                std::span<const Eigen::Vector3d> target,
+                                std::span<const double> weights) {
+  const std::optional<Sim3> S = align(source, target, weights, /*with_scale=*/false);
+  if (!S) return std::nullopt;
   Pose T = Pose::Identity();
-  T.linear() = svd.matrixU() * sign * svd.matrixV().transpose();
-  T.translation() = target_mean - T.linear() * source_mean;
+  T.linear() = S->rotation;
+  T.translation() = S->translation;
   return T;
+}
+
+std::optional<Sim3> align_similarity(std::span<const Eigen::Vector3d> source,
+                                     std::span<const Eigen::Vector3d> target,
+                                     std::span<const double> weights) {
+  return align(source, target, weights, /*with_scale=*/true);
 }
 
 RigidRansacResult solve_rigid_ransac(std::span<const RigidCorrespondence> correspondences,
@@ -81,7 +107,7 @@ RigidRansacResult solve_rigid_ransac(std::span<const RigidCorrespondence> corres
   std::uniform_int_distribution<size_t> pick(0, n - 1);
   std::vector<std::uint8_t> candidate(n, 0);
   int best_inliers = 0;
-  Pose best = Pose::Identity();
+  Sim3 best;
   int needed_iterations = options.max_iterations;
   std::array<Eigen::Vector3d, 3> source;
   std::array<Eigen::Vector3d, 3> target;
@@ -98,7 +124,7 @@ RigidRansacResult solve_rigid_ransac(std::span<const RigidCorrespondence> corres
       source[k] = correspondences[sample[k]].source;
       target[k] = correspondences[sample[k]].target;
     }
-    const std::optional<Pose> T = align_rigid(source, target);
+    const std::optional<Sim3> T = align(source, target, {}, options.estimate_scale);
     if (!T) continue;
     const int inliers = count_inliers(correspondences, *T, nullptr);
     if (inliers <= best_inliers) continue;
@@ -117,14 +143,15 @@ RigidRansacResult solve_rigid_ransac(std::span<const RigidCorrespondence> corres
   if (best_inliers < 3) return result;
 
   // Refit on the inliers; the larger inlier set of the refit usually grows once more.
-  result.T_target_source = best;
+  result.S_target_source = best;
   result.num_inliers = count_inliers(correspondences, best, &result.inlier);
   for (int refit = 0; refit < 2; ++refit) {
-    const std::optional<Pose> refined = align_inliers(correspondences, result.inlier);
+    const std::optional<Sim3> refined =
+        align_inliers(correspondences, result.inlier, options.estimate_scale);
     if (!refined) break;
     const int inliers = count_inliers(correspondences, *refined, &candidate);
     if (inliers < result.num_inliers) break;
-    result.T_target_source = *refined;
+    result.S_target_source = *refined;
     result.num_inliers = inliers;
     result.inlier.swap(candidate);
   }

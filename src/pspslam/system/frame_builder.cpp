@@ -226,6 +226,19 @@ class MonocularFrameBuilder final : public FrameBuilder {
     options.redundancy_needs_depth = false;
   }
 
+  void adapt(LoopClosingOptions& options) const override {
+    // A single camera's map drifts in scale: the loop transform is a similarity and the
+    // essential graph spreads the scale error too (ORB-SLAM2's Sim3Solver, OptimizeSim3 and
+    // OptimizeEssentialGraph for monocular). The map has no metric unit, so the RANSAC inlier
+    // test is relative to the depth: 3 % of it, about 1.7° seen sideways. The reprojection checks
+    // of the refinement that follows are in pixels and need no change.
+    options.detector.ransac.estimate_scale = true;
+    options.detector.ransac_error_base = 0.0;
+    options.detector.ransac_error_per_depth = 0.03;
+    options.detector.ransac_error_per_depth2 = 0.0;
+    options.correction.pose_graph.optimize_scale = true;
+  }
+
  private:
   OrbExtractor extractor_;
   std::shared_ptr<const RgbdCamera> camera_;
@@ -248,12 +261,6 @@ SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options) {
     limits.dynamic_note = std::string(to_string(mode)) + " runs as " +
                           to_string(options.dynamic.mode) +
                           " (monocular: the geometry stage needs depth images)";
-  }
-  if (options.place.loop_closing) {
-    // A monocular loop needs a Sim(3) correction for the scale drift; the loop corrector is
-    // SE(3) (loop/loop_corrector.h), which would bend a drifted map at the loop.
-    options.place.loop_closing = false;
-    limits.loop_closing_note = "monocular: Sim(3) correction not implemented";
   }
   return limits;
 }

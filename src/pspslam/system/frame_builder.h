@@ -9,6 +9,7 @@
 #include "pspslam/config/config.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/mapping/local_mapping_options.h"
 #include "pspslam/system/system.h"
@@ -57,14 +58,15 @@ class FrameBuilder {
   }
   // Local mapping rules that depend on depth readings.
   virtual void adapt(LocalMappingOptions&) const {}
+  // Loop closing: whether the loop transform has a scale (Sim(3)) and how it is verified.
+  virtual void adapt(LoopClosingOptions&) const {}
 };
 
 // What a sensor cannot run, taken out of the run's options before the System starts, with the
 // reason the run summary prints (empty: nothing changed).
 struct SensorLimits {
   DynamicMode requested_mode = DynamicMode::off;
-  std::string dynamic_note;       // e.g. "full runs as semantic (monocular: ...)"
-  std::string loop_closing_note;  // e.g. "monocular: Sim(3) correction not implemented"
+  std::string dynamic_note;  // e.g. "full runs as semantic (monocular: ...)"
 };
 SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options);
 

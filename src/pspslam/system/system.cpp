@@ -232,6 +232,7 @@ System::System(const SystemConfig& config, SystemOptions options)
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     LoopClosingOptions loop_options;
     loop_options.thread_nice = options.background_thread_nice;
+    frame_builder_->adapt(loop_options);
     // The global BA weighs depth as local BA does; otherwise it moves weakly connected keyframes
     // away from where local BA's depth constraint held them (#15 item 5).
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
@@ -433,6 +434,7 @@ MappingStats System::mapping_stats() const {
     stats.global_ba_applied = loop.global_ba_applied;
     stats.global_ba_aborted = loop.global_ba_aborted;
     stats.last_loop_correction_m = loop.last_correction.correction_m;
+    stats.last_loop_correction_scale = loop.last_correction.correction_scale;
     stats.last_global_ba_seconds = loop.last_global_ba_seconds;
   }
   return stats;

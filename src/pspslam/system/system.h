@@ -107,7 +107,8 @@ struct MappingStats {
   size_t loop_candidates_rejected = 0;  // consistent BoW candidates failing verification
   size_t global_ba_applied = 0;
   size_t global_ba_aborted = 0;
-  double last_loop_correction_m = 0.0;  // how far the last loop moved its keyframe
+  double last_loop_correction_m = 0.0;      // how far the last loop moved its keyframe
+  double last_loop_correction_scale = 1.0;  // and how it resized its neighbourhood (monocular)
   double last_global_ba_seconds = 0.0;
 };
 

@@ -158,7 +158,10 @@ void Tracker::on_map_corrected() {
   const auto reference = anchor.reference.lock();
   if (!reference || reference->is_bad()) return;
   const Pose corrected = orthonormalized(anchor.T_camera_reference * reference->T_camera_world());
-  // The velocity is relative (T_current_last) and stays valid under a rigid correction.
+  // The velocity is relative (T_current_last) and stays valid under a rigid correction. Under a
+  // monocular loop's Sim(3) correction its translation (and the anchor's) keeps the old scale
+  // for the next frame: off by the resize (a few per cent of a frame's motion), which that
+  // frame's pose optimisation removes.
   last_tracked_pose_ = corrected;
   if (last_frame_ && last_frame_->has_pose()) last_frame_->set_pose(corrected);
 }

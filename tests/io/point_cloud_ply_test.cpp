@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "pspslam/core/error.h"
+#include "support/test_support.h"
 
 namespace pspslam {
 namespace {
 
+// A file in a folder of its own, removed when the test passes (support/test_support.h).
 std::filesystem::path temp_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "pspslam_test_ply";
-  std::filesystem::create_directories(dir);
-  return dir / name;
+  return testing::make_temp_dir("ply_" + name) / name;
 }
 
 std::string error_of(const std::filesystem::path& file) {

@@ -658,7 +658,8 @@ TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
 // Monocular loop closing (issue #16): a colour-only run around a synthetic loop (1.25 turns in
 // 480 frames, static room) closes the loop with a similarity, says by how much it resized the
 // map, and the final trajectory gains from it. Measured once each: final ATE 7.3 mm with loop
-// closing, 12.2 mm with --loop-closing off; online 9.9 / 12.9 mm.
+// closing, 12.2 mm with --loop-closing off; online 9.9 / 12.9 mm. The corrected map, saved,
+// serves a localisation run, whose summary reports the loaded map instead of a two-view start.
 TEST(CliRun, MonocularLoopIsClosedWithASimilarity) {
   const auto dir = testing::make_temp_dir("cli_mono_loop");
   const Result synth = pspslam("synth --out " + (dir / "seq").string() +
@@ -666,8 +667,10 @@ TEST(CliRun, MonocularLoopIsClosedWithASimilarity) {
                                "--seed 1");
   ASSERT_EQ(synth.status, 0) << synth.output;
   const auto out = dir / "out";
+  const auto map_file = dir / "loop.map";
   const Result run = pspslam("run --sequence " + (dir / "seq").string() +
-                             " --sensor monocular --dynamic off --out " + out.string());
+                             " --sensor monocular --dynamic off --out " + out.string() +
+                             " --save-map " + map_file.string());
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "loop closing: on\n")) << run.output;
   EXPECT_TRUE(contains(run.output, " closed (last moved its keyframe ")) << run.output;
@@ -680,6 +683,19 @@ TEST(CliRun, MonocularLoopIsClosedWithASimilarity) {
   EXPECT_NE(resized, 1.0) << "a monocular loop must estimate its scale";
   EXPECT_GE(stats["monocular"]["tracked_since_initialisation"].get<int>(), 470) << run.output;
   EXPECT_LT(stats["ate_refined"]["rmse"].get<double>(), 0.010) << run.output;
+
+  const auto localised = dir / "localised";
+  const Result again = pspslam("run --sequence " + (dir / "seq").string() +
+                               " --sensor monocular --dynamic off --max-frames 120 --load-map " +
+                               map_file.string() + " --localization --out " + localised.string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_TRUE(contains(again.output,
+                       "monocular:    map loaded (no two-view start); 120 of 120 frames tracked "
+                       "(100.0 %)\n"))
+      << again.output;
+  const nlohmann::json localised_stats = nlohmann::json::parse(read_text(localised / "stats.json"));
+  EXPECT_EQ(localised_stats["monocular"]["map_loaded"], true);
+  EXPECT_LT(localised_stats["ate"]["rmse"].get<double>(), 0.010) << again.output;
 }
 
 // --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own

@@ -142,8 +142,17 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   out << line;
   const bool monocular = input.sensor == SensorType::monocular;
   if (system.place.loop_closing) print_loop_stats(mapping, monocular, out);
+  // A loaded map (--load-map) is there from the first frame: no two-view start to report.
+  const bool map_loaded = !system.map_file.empty();
   if (monocular) {
-    if (stats.initialised_at()) {
+    if (map_loaded) {
+      const size_t tracked = stats.processed() - stats.lost();
+      std::snprintf(line, sizeof(line),
+                    "monocular:    map loaded (no two-view start); %zu of %zu frames tracked "
+                    "(%.1f %%)\n",
+                    tracked, stats.processed(),
+                    stats.processed() > 0 ? 100.0 * tracked / stats.processed() : 0.0);
+    } else if (stats.initialised_at()) {
       const size_t since = stats.processed_since_initialisation();
       std::snprintf(line, sizeof(line),
                     "monocular:    map started at frame %zu; %zu of %zu frames tracked from "
@@ -256,7 +265,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                                                  : nlohmann::ordered_json(nullptr)},
                          {"frames_since_initialisation", stats.processed_since_initialisation()},
                          {"tracked_since_initialisation", stats.tracked_since_initialisation()},
-                         {"map_restarts", stats.map_restarts()}};
+                         {"map_restarts", stats.map_restarts()},
+                         {"map_loaded", map_loaded}};
   }
   nlohmann::ordered_json longest_lost = nullptr;
   if (const auto longest = stats.longest_lost_stretch()) {

@@ -30,7 +30,7 @@ spread has not lost. A variant is worth adopting when it wins on most cells and 
 the spread nowhere.
 
 Per cell and file (trajectory.txt = online, trajectory_refined.txt = final) the ATE RMSE (SE(3),
-`pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
+Sim(3) for a monocular run; `pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
 to the ground truth than the online poses of the same frames. Writes WORK/panel.md and
 WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes (delete WORK, or
 give another, after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no
@@ -184,11 +184,15 @@ def apply_sed(text, expression):
                           check=True).stdout
 
 
-def evaluate(cli, ground_truth, estimate, body_to_camera=None):
-    """ATE RMSE (m) and pose count, or (None, 0) when nothing could be associated."""
+def evaluate(cli, ground_truth, estimate, body_to_camera=None, sim3=False):
+    """ATE RMSE (m) and pose count, or (None, 0) when nothing could be associated. `sim3`: align
+    with scale (a monocular run), also for files away from the run's stats.json, which is what
+    `pspslam eval` would otherwise read it from."""
     if not estimate.exists() or estimate.stat().st_size == 0:
         return None, 0
     command = [str(cli), "-q", "eval", "--gt", str(ground_truth), "--est", str(estimate), "--json"]
+    if sim3:
+        command.append("--sim3")
     if body_to_camera:
         command += ["--gt-body-to-camera", str(body_to_camera)]
     result = subprocess.run(command, capture_output=True, text=True)
@@ -230,16 +234,17 @@ def run_one(job):
     run_stats = json.loads(stats.read_text())
     run = out / "run"
     results = {}
+    sim3 = run_stats.get("sensor") == "monocular"
     for name, ground_truth in cell.stretches:
         body = cell.body_to_camera
-        online, tracked = evaluate(cli, ground_truth, run / "trajectory.txt", body)
-        final, _ = evaluate(cli, ground_truth, run / "trajectory_refined.txt", body)
-        keyframes, keyframe_count = evaluate(cli, ground_truth, run / "keyframes.txt", body)
+        online, tracked = evaluate(cli, ground_truth, run / "trajectory.txt", body, sim3)
+        final, _ = evaluate(cli, ground_truth, run / "trajectory_refined.txt", body, sim3)
+        keyframes, keyframe_count = evaluate(cli, ground_truth, run / "keyframes.txt", body, sim3)
         online_at_keyframes = None
         if keyframe_count:
             subset = out / f"online_at_keyframes_{name}.txt"
             poses_at_stamps(run / "trajectory.txt", run / "keyframes.txt", subset)
-            online_at_keyframes, _ = evaluate(cli, ground_truth, subset, body)
+            online_at_keyframes, _ = evaluate(cli, ground_truth, subset, body, sim3)
         results[name] = {"online": online, "final": final, "tracked": tracked,
                          "frames": run_stats["frames"], "keyframes": keyframes,
                          "online_at_keyframes": online_at_keyframes,
@@ -258,7 +263,8 @@ def summarise(cells, base, variant, spread, args):
              f"mode `{args.mode}`; baseline: build `{args.base_build}`, flags "
              f"`{args.base_flags or '(none)'}`, sed `{args.base_sed or '(none)'}`; variant: build "
              f"`{args.variant_build}`, flags `{args.variant_flags or '(none)'}`, sed "
-             f"`{args.variant_sed or '(none)'}`. ATE RMSE in mm (SE(3)); tracked = frames with a "
+             f"`{args.variant_sed or '(none)'}`. ATE RMSE in mm (SE(3); Sim(3) for monocular "
+             f"runs); tracked = frames with a "
              f"pose evaluated / frames processed; KF = keyframes after BA vs the online poses of "
              f"the same frames (mm); spread = |baseline − baseline with the depth factor one "
              f"unit up|.", "",

@@ -14,6 +14,7 @@
 #include <numbers>
 #include <random>
 
+#include "pspslam/loop/loop_closing.h"
 #include "pspslam/loop/loop_corrector.h"
 #include "pspslam/loop/loop_detector.h"
 #include "pspslam/map/frame.h"
@@ -192,21 +193,31 @@ double center_error(const Pose& a, const Pose& b) {
   return (a.inverse().translation() - b.inverse().translation()).norm();
 }
 
+// Adds the world's keyframes one by one, as local mapping hands them to loop closing, until the
+// detector accepts a loop or the 1.5 turns end; `detected_at` is the keyframe that closed it.
+std::optional<DetectedLoop> run_until_loop(LoopWorld& world, Map& map, PlaceRecognition& place,
+                                           LoopDetector& detector, int* detected_at = nullptr) {
+  for (int k = 0; k <= kKeyframesPerTurn * 3 / 2; ++k) {
+    const auto keyframe = world.add_keyframe(k, map, place);
+    const auto candidates = detector.detect(keyframe);
+    if (candidates.empty()) continue;
+    if (auto loop = detector.verify(keyframe, candidates)) {
+      if (detected_at != nullptr) *detected_at = k;
+      return loop;
+    }
+  }
+  return std::nullopt;
+}
+
 TEST(LoopDetection, SyntheticLoopIsFoundOnRevisitAndCorrected) {
   const auto place = PlaceRecognition::load(default_vocabulary_path());
   Map map;
   LoopWorld world(11);
   LoopDetector detector(map, *place);
-  std::optional<DetectedLoop> loop;
   int detected_at = -1;
+  const std::optional<DetectedLoop> loop =
+      run_until_loop(world, map, *place, detector, &detected_at);
   const int last = kKeyframesPerTurn * 3 / 2;
-  for (int k = 0; k <= last && !loop; ++k) {
-    const auto keyframe = world.add_keyframe(k, map, *place);
-    const auto candidates = detector.detect(keyframe);
-    if (candidates.empty()) continue;
-    loop = detector.verify(keyframe, candidates);
-    if (loop) detected_at = k;
-  }
   ASSERT_TRUE(loop.has_value()) << "no loop in " << last + 1 << " keyframes; BoW candidates "
                                 << detector.stats().bow_candidates << ", consistent "
                                 << detector.stats().consistent_candidates;
@@ -269,13 +280,7 @@ TEST(LoopDetection, KeyframesAreBackOnTheTruthAfterCorrectionAndGlobalBa) {
   Map map;
   LoopWorld world(11);
   LoopDetector detector(map, *place);
-  std::optional<DetectedLoop> loop;
-  const int last = kKeyframesPerTurn * 3 / 2;
-  for (int k = 0; k <= last && !loop; ++k) {
-    const auto keyframe = world.add_keyframe(k, map, *place);
-    const auto candidates = detector.detect(keyframe);
-    if (!candidates.empty()) loop = detector.verify(keyframe, candidates);
-  }
+  const std::optional<DetectedLoop> loop = run_until_loop(world, map, *place, detector);
   ASSERT_TRUE(loop.has_value());
   const auto keyframes = map.keyframes();
   // Centre error of every keyframe relative to keyframe 0, the global BA's gauge (the essential
@@ -335,22 +340,12 @@ TEST(LoopDetection, MonocularLoopIsASimilarityAndItsScaleIsCorrected) {
   const auto place = PlaceRecognition::load(default_vocabulary_path());
   Map map;
   LoopWorld world(11, /*monocular=*/true);
-  LoopDetectorOptions options;  // as the monocular FrameBuilder sets them (system/)
-  options.ransac.estimate_scale = true;
-  options.ransac_error_base = 0.0;
-  options.ransac_error_per_depth = 0.03;
-  options.ransac_error_per_depth2 = 0.0;
-  LoopDetector detector(map, *place, options);
-  std::optional<DetectedLoop> loop;
+  LoopClosingOptions options;  // as the monocular FrameBuilder sets them (system/)
+  close_loops_with_scale(options);
+  LoopDetector detector(map, *place, options.detector);
   int detected_at = -1;
-  const int last = kKeyframesPerTurn * 3 / 2;
-  for (int k = 0; k <= last && !loop; ++k) {
-    const auto keyframe = world.add_keyframe(k, map, *place);
-    const auto candidates = detector.detect(keyframe);
-    if (candidates.empty()) continue;
-    loop = detector.verify(keyframe, candidates);
-    if (loop) detected_at = k;
-  }
+  const std::optional<DetectedLoop> loop =
+      run_until_loop(world, map, *place, detector, &detected_at);
   ASSERT_TRUE(loop.has_value()) << "no loop; consistent candidates "
                                 << detector.stats().consistent_candidates << ", rejected "
                                 << detector.stats().rejected_geometry;
@@ -367,9 +362,7 @@ TEST(LoopDetection, MonocularLoopIsASimilarityAndItsScaleIsCorrected) {
       center_error(loop->current->T_camera_world(), LoopWorld::true_pose(detected_at));
   const double depth_ratio_before = world.depth_ratio(*loop->current);
   LoopEdges edges;
-  LoopCorrectionOptions correction;
-  correction.pose_graph.optimize_scale = true;
-  const LoopCorrectionReport report = correct_loop(map, *loop, edges, correction, {});
+  const LoopCorrectionReport report = correct_loop(map, *loop, edges, options.correction, {});
   ASSERT_TRUE(report.graph.usable);
   EXPECT_NEAR(report.correction_scale, 1.0 / loop->S_current_world.scale, 1e-12);
   const double error_after =

@@ -10,6 +10,14 @@
 
 namespace pspslam {
 
+void close_loops_with_scale(LoopClosingOptions& options) {
+  options.detector.ransac.estimate_scale = true;
+  options.detector.ransac_error_base = 0.0;
+  options.detector.ransac_error_per_depth = 0.03;
+  options.detector.ransac_error_per_depth2 = 0.0;
+  options.correction.pose_graph.optimize_scale = true;
+}
+
 LoopClosing::LoopClosing(std::shared_ptr<Map> map, std::shared_ptr<PlaceRecognition> place,
                          LocalMapping* local_mapping, LoopClosingOptions options,
                          std::function<void()> on_map_corrected)

@@ -46,6 +46,13 @@ struct LoopClosingOptions {
   int thread_nice = 0;
 };
 
+// Loop closing for a map without a metric unit whose scale drifts (monocular): the loop transform
+// is a similarity and the essential graph spreads the scale error too (ORB-SLAM2's Sim3Solver,
+// OptimizeSim3 and OptimizeEssentialGraph for monocular). The RANSAC inlier test becomes relative
+// to the depth: 3 % of it, about 1.7° seen sideways. The reprojection checks of the refinement
+// that follows are in pixels and need no change.
+void close_loops_with_scale(LoopClosingOptions& options);
+
 struct LoopClosingStats {
   LoopDetectorStats detector;
   std::uint64_t loops_closed = 0;

@@ -226,18 +226,8 @@ class MonocularFrameBuilder final : public FrameBuilder {
     options.redundancy_needs_depth = false;
   }
 
-  void adapt(LoopClosingOptions& options) const override {
-    // A single camera's map drifts in scale: the loop transform is a similarity and the
-    // essential graph spreads the scale error too (ORB-SLAM2's Sim3Solver, OptimizeSim3 and
-    // OptimizeEssentialGraph for monocular). The map has no metric unit, so the RANSAC inlier
-    // test is relative to the depth: 3 % of it, about 1.7° seen sideways. The reprojection checks
-    // of the refinement that follows are in pixels and need no change.
-    options.detector.ransac.estimate_scale = true;
-    options.detector.ransac_error_base = 0.0;
-    options.detector.ransac_error_per_depth = 0.03;
-    options.detector.ransac_error_per_depth2 = 0.0;
-    options.correction.pose_graph.optimize_scale = true;
-  }
+  // A single camera's map drifts in scale: its loops are similarities (loop/loop_closing.h).
+  void adapt(LoopClosingOptions& options) const override { close_loops_with_scale(options); }
 
  private:
   OrbExtractor extractor_;

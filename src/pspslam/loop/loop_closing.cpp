@@ -15,6 +15,7 @@ void close_loops_with_scale(LoopClosingOptions& options) {
   options.detector.ransac_error_base = 0.0;
   options.detector.ransac_error_per_depth = 0.03;
   options.detector.ransac_error_per_depth2 = 0.0;
+  options.detector.refine_by_reprojection = true;
   options.correction.pose_graph.optimize_scale = true;
 }
 

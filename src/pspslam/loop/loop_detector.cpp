@@ -6,6 +6,7 @@
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
+#include "pspslam/optimize/similarity_optimization.h"
 #include "pspslam/place/place_recognition.h"
 
 namespace pspslam {
@@ -210,6 +211,29 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
       if (!refined) return std::nullopt;
       S_current_candidate = Sim3(*refined);
     }
+  }
+  if (options_.refine_by_reprojection) {
+    std::vector<SimilarityPair> reprojected;
+    std::vector<size_t> pair_of;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      if (!inlier[k]) continue;
+      const cv::KeyPoint& in_current = keyframe->keypoints()[pairs[k].index];
+      const cv::KeyPoint& in_candidate = candidate->keypoints()[pairs[k].candidate_index];
+      reprojected.push_back({pairs[k].in_current, pairs[k].in_candidate,
+                             Eigen::Vector2d(in_current.pt.x, in_current.pt.y),
+                             Eigen::Vector2d(in_candidate.pt.x, in_candidate.pt.y),
+                             keyframe->pyramid().inv_sigma2[in_current.octave],
+                             candidate->pyramid().inv_sigma2[in_candidate.octave]});
+      pair_of.push_back(k);
+    }
+    SimilarityOptimizationOptions refinement;
+    refinement.estimate_scale = options_.ransac.estimate_scale;
+    const SimilarityOptimizationResult refined = optimize_similarity(
+        keyframe->camera().pinhole, S_current_candidate, reprojected, refinement);
+    if (refined.num_inliers < options_.min_verified_inliers) return std::nullopt;
+    S_current_candidate = refined.S_a_b;
+    inliers = refined.num_inliers;
+    for (size_t j = 0; j < pair_of.size(); ++j) inlier[pair_of[j]] = refined.inlier[j];
   }
   for (size_t k = 0; k < pairs.size(); ++k) {
     if (!inlier[k]) matched[pairs[k].index] = nullptr;

@@ -45,6 +45,10 @@ struct LoopDetectorOptions {
   double guided_radius = 7.5;       // pixels at level 0 (SearchBySim3)
   double reprojection_chi2 = 9.21;  // 2-dof χ² at 99%, in both images
   int min_verified_inliers = 20;    // after refinement (ORB-SLAM2: 20)
+  // Then refine the transform by reprojection in both keyframes (optimize_similarity, ORB-SLAM2
+  // OptimizeSim3). Monocular: the 3D fit above weighs the poorly known depth of triangulated
+  // points like their bearing. RGB-D and stereo keep the 3D fit (measured depth).
+  bool refine_by_reprojection = false;
   double projection_radius = 10.0;  // candidate neighbourhood projected into the keyframe
   int min_projection_matches = 40;  // total matches to accept (ORB-SLAM2: 40)
 };

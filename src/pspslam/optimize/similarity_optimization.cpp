@@ -80,24 +80,30 @@ SimilarityOptimizationResult optimize_similarity(const PinholeCamera& camera, co
   const auto current = [&] {
     return Sim3(quaternion.normalized().toRotationMatrix(), translation, std::exp(log_scale));
   };
-  const auto inlier = [&](const Sim3& S_a_b, const SimilarityPair& pair) {
-    return chi2_in(camera, S_a_b * pair.in_b, pair.pixel_in_a, pair.information_a) <=
-               options.chi2 &&
-           chi2_in(camera, S_a_b.inverse() * pair.in_a, pair.pixel_in_b, pair.information_b) <=
-               options.chi2;
+  // χ² test in both images with the given transform; flags[k] for each pair, returns the count.
+  const auto mark_inliers = [&](const Sim3& S_a_b, std::vector<std::uint8_t>& flags) {
+    const Sim3 S_b_a = S_a_b.inverse();
+    int count = 0;
+    flags.resize(pairs.size());
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const SimilarityPair& pair = pairs[k];
+      const bool in_a =
+          chi2_in(camera, S_a_b * pair.in_b, pair.pixel_in_a, pair.information_a) <= options.chi2;
+      const bool in_b =
+          chi2_in(camera, S_b_a * pair.in_a, pair.pixel_in_b, pair.information_b) <= options.chi2;
+      flags[k] = in_a && in_b ? 1 : 0;
+      count += flags[k];
+    }
+    return count;
   };
 
   solve(options.first_iterations);
-  for (std::size_t k = 0; k < pairs.size(); ++k) used[k] = inlier(current(), pairs[k]) ? 1 : 0;
+  mark_inliers(current(), used);
   solve(options.second_iterations);
 
   SimilarityOptimizationResult result;
   result.S_a_b = current();
-  result.inlier.resize(pairs.size());
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    result.inlier[k] = inlier(result.S_a_b, pairs[k]) ? 1 : 0;
-    result.num_inliers += result.inlier[k];
-  }
+  result.num_inliers = mark_inliers(result.S_a_b, result.inlier);
   return result;
 }
 

@@ -65,6 +65,7 @@ TEST(Config, SaveLoadRoundTrip) {
   config.camera.depth_noise_scale = 1.5;
   config.camera.depth_shift_x = -2;
   config.camera.depth_shift_y = 1;
+  config.camera.rolling_shutter_readout_s = -0.0275;  // 15 fps: within 1/fps, bottom row first
   config.orb.n_features = 1500;
   config.orb.scale_factor = 1.3;
   config.orb.n_levels = 6;
@@ -88,6 +89,7 @@ TEST(Config, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded.camera.depth_noise_scale, 1.5);
   EXPECT_EQ(loaded.camera.depth_shift_x, -2);
   EXPECT_EQ(loaded.camera.depth_shift_y, 1);
+  EXPECT_EQ(loaded.camera.rolling_shutter_readout_s, -0.0275);
   EXPECT_EQ(loaded.orb.n_features, 1500);
   EXPECT_EQ(loaded.orb.scale_factor, 1.3);
   EXPECT_EQ(loaded.orb.n_levels, 6);
@@ -101,6 +103,13 @@ TEST(Config, SaveLoadRoundTrip) {
   const std::string text((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find("mask_compensation"), std::string::npos) << text;
   EXPECT_FALSE(load_config(dir / "saved_off.yaml").orb.mask_compensation);
+  // A global shutter (0, the default) is not written either.
+  config.camera.rolling_shutter_readout_s = 0.0;
+  save_config(dir / "saved_global.yaml", config);
+  std::ifstream global(dir / "saved_global.yaml");
+  const std::string global_text((std::istreambuf_iterator<char>(global)),
+                                std::istreambuf_iterator<char>());
+  EXPECT_EQ(global_text.find("rolling_shutter"), std::string::npos) << global_text;
 }
 
 TEST(Config, AllPresetsLoad) {
@@ -108,6 +117,7 @@ TEST(Config, AllPresetsLoad) {
   const SystemConfig bonn = load_config(presets / "bonn.yaml");
   EXPECT_EQ(bonn.camera.name, "bonn");
   EXPECT_DOUBLE_EQ(bonn.camera.pinhole.fx, 542.822841);
+  EXPECT_DOUBLE_EQ(bonn.camera.rolling_shutter_readout_s, 0.03);
   EXPECT_DOUBLE_EQ(bonn.camera.pinhole.cy, 237.756098);
   EXPECT_DOUBLE_EQ(bonn.camera.pinhole.distortion[0], 0.039903);
   EXPECT_DOUBLE_EQ(bonn.camera.depth_factor, 5000.0);
@@ -294,6 +304,14 @@ TEST(Config, InvalidValues) {
   EXPECT_EQ(
       load_error(fractional),
       fractional.string() + ":13: key 'camera.depth_registration_shift_px' has an invalid value");
+  // 13: the line of the appended key.
+  const auto readout =
+      write_file(dir, std::string(kValidCamera) + "  rolling_shutter_readout: 0.05\n");
+  EXPECT_EQ(
+      load_error(readout),
+      readout.string() +
+          ":13: key 'camera.rolling_shutter_readout' must be seconds within +-1/fps (a sensor "
+          "reads its rows within one frame; negative: bottom row first), got 0.050000");
   const auto broken = write_file(dir, "camera: [1, 2\n");
   EXPECT_EQ(load_error(broken).rfind(broken.string() + ":2: invalid YAML: ", 0), 0u)
       << load_error(broken);

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <vector>
@@ -76,6 +77,14 @@ CameraConfig read_camera(YamlSection section) {
   require_positive(p.fx, section, "fx");
   require_positive(p.fy, section, "fy");
   require_positive(camera.fps, section, "fps");
+  camera.rolling_shutter_readout_s = section.optional("rolling_shutter_readout", 0.0);
+  if (!(std::abs(camera.rolling_shutter_readout_s) <= 1.0 / camera.fps)) {
+    throw Error(section.where("rolling_shutter_readout") + "key '" +
+                section.qualified("rolling_shutter_readout") +
+                "' must be seconds within +-1/fps (a sensor reads its rows within one frame; "
+                "negative: bottom row first), got " +
+                std::to_string(camera.rolling_shutter_readout_s));
+  }
   if (camera.type == SensorType::monocular) {
     // No depth at all: nothing is "close" or "far" (depth_threshold is not read).
     refuse_depth_image_keys(section, camera.type);
@@ -199,6 +208,10 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
       << std::vector<double>(p.distortion.begin(), p.distortion.end());
   out << YAML::Key << "fps" << YAML::Value << config.camera.fps;
+  if (config.camera.rolling_shutter_readout_s != 0.0) {
+    out << YAML::Key << "rolling_shutter_readout" << YAML::Value
+        << config.camera.rolling_shutter_readout_s;
+  }
   if (stereo) {
     out << YAML::Key << "baseline" << YAML::Value << config.camera.baseline;
     out << YAML::Key << "depth_threshold" << YAML::Value << config.camera.depth_threshold;

@@ -27,6 +27,11 @@ struct CameraConfig {
   double baseline = 0.0;
   PinholeCamera pinhole;
   double fps = 30.0;
+  // Seconds the (left) colour sensor takes to read its rows top to bottom (optional key
+  // `rolling_shutter_readout`, any sensor type; 0 = global shutter, the default; negative: the
+  // bottom row is read first). Keypoints are moved to the frame's instant with the rotation rate
+  // tracking measures (camera/rolling_shutter.h, optimize/rolling_shutter_pose.h).
+  double rolling_shutter_readout_s = 0.0;
   double depth_factor = 5000.0;  // depth image units per metre (5000 for TUM and Bonn)
   double depth_threshold = 4.0;  // metres: closer points are "close" (reliable) points
   // How a depth reading is weighed against the pixel in pose optimisation and bundle adjustment

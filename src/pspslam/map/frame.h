@@ -24,16 +24,22 @@ class Frame {
  public:
   // `keypoints` are in distorted image coordinates as the extractor returns them; depth is
   // read there (the depth image is registered to the distorted colour image), then the
-  // keypoints are undistorted once. `descriptors`: N x 32 CV_8U (shared, not copied).
+  // keypoints are undistorted once and, for a rolling-shutter camera
+  // (RgbdCamera::rolling_shutter_readout_s), moved to the frame's instant with
+  // `angular_velocity` (rad/s, camera frame; camera/rolling_shutter.h). `descriptors`: N x 32
+  // CV_8U (shared, not copied).
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
         cv::Mat descriptors, const cv::Mat& depth_metres, std::shared_ptr<const RgbdCamera> camera,
-        std::shared_ptr<const ScalePyramid> pyramid);
+        std::shared_ptr<const ScalePyramid> pyramid,
+        const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
   // A frame whose depth was measured per keypoint (a rectified stereo pair: depth and right
   // coordinate from match/stereo_matcher.h; depth <= 0 and NaN where a keypoint has no partner).
-  // Keypoints are in the rectified image, which has no distortion.
+  // Keypoints are in the rectified image, which has no distortion; both cameras are taken to
+  // read their rows together, so a rolling-shutter correction turns the triangulated point.
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
         cv::Mat descriptors, std::vector<float> depth, std::vector<float> right_u,
-        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid);
+        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid,
+        const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
 
   std::uint64_t id() const { return id_; }
   Timestamp timestamp() const { return timestamp_; }
@@ -61,6 +67,12 @@ class Frame {
                         std::vector<int>& out) const {
     grid_.query(keypoints_, x, y, radius, min_level, max_level, out);
   }
+
+  // Rolling shutter: the rate tracking measured differs from the one the keypoints were moved
+  // with by `rate_correction` (rad/s, camera frame; optimize/rolling_shutter_pose.h): moves them
+  // the rest of the way. Depth stays (taken at the frame's instant); the right coordinate keeps
+  // its disparity. The row of a keypoint is taken at its undistorted y (the rest is small).
+  void correct_rotation_rate(const Eigen::Vector3d& rate_correction);
 
   // Pose (unset until tracking estimates it; lost frames never get one).
   bool has_pose() const { return T_camera_world_.has_value(); }

@@ -23,6 +23,7 @@ RgbdCamera RgbdCamera::from_config(const CameraConfig& camera, double virtual_ba
       break;
   }
   c.depth_threshold = camera.depth_threshold;
+  c.rolling_shutter_readout_s = camera.rolling_shutter_readout_s;
   const double w = camera.pinhole.width;
   const double h = camera.pinhole.height;
   std::vector<cv::Point2f> corners = {{0.0f, 0.0f},

@@ -10,8 +10,9 @@ namespace pspslam {
 // (ORB-SLAM2's RGB-D treatment), and the depth below which a point counts as "close".
 struct RgbdCamera {
   PinholeCamera pinhole;
-  double bf = 0.0;               // fx * virtual baseline [pixel * metre]
-  double depth_threshold = 4.0;  // metres
+  double bf = 0.0;                         // fx * virtual baseline [pixel * metre]
+  double depth_threshold = 4.0;            // metres
+  double rolling_shutter_readout_s = 0.0;  // 0: global shutter (camera/rolling_shutter.h)
   // Bounds of the undistorted image (the distorted border maps to a slightly different box).
   double min_x = 0.0;
   double max_x = 0.0;

@@ -781,6 +781,9 @@ Pose SyntheticScene::ground_truth_pose(size_t index) const {
 SystemConfig SyntheticScene::rgbd_system_config() const {
   SystemConfig config = synthetic_system_config();
   if (impl_->distortion) config.camera.pinhole.distortion = synth::kKinectDistortion;
+  // The sensor's readout, as a user would take it from the camera's data sheet.
+  if (impl_->kinect(&synth::KinectFaults::rolling_shutter))
+    config.camera.rolling_shutter_readout_s = synth::kKinectReadout_s;
   return config;
 }
 

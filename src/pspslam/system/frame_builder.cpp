@@ -28,10 +28,10 @@ class RgbdFrameBuilder final : public FrameBuilder {
 
   cv::Mat depth_image(const RgbdFrame& frame) override { return frame.depth; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
-              const cv::Mat&) override {
+  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+              const Eigen::Vector3d& angular_velocity) override {
     return Frame(id, frame.timestamp, std::move(features.keypoints),
-                 std::move(features.descriptors), frame.depth, camera_, pyramid_);
+                 std::move(features.descriptors), frame.depth, camera_, pyramid_, angular_velocity);
   }
 
  private:
@@ -130,8 +130,8 @@ class StereoFrameBuilder final : public FrameBuilder {
 
   std::span<const float> keypoint_depths() const override { return depths_.depth; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
-              const cv::Mat&) override {
+  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+              const Eigen::Vector3d& angular_velocity) override {
     // The kept keypoints are an order-preserving subset of the extracted ones (dynamic removal
     // compacts in place): walk both lists to carry each kept keypoint's match over.
     std::vector<float> depth(features.keypoints.size());
@@ -150,7 +150,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     }
     return Frame(id, frame.timestamp, std::move(features.keypoints),
                  std::move(features.descriptors), std::move(depth), std::move(right_u), camera_,
-                 pyramid_);
+                 pyramid_, angular_velocity);
   }
 
  private:
@@ -208,10 +208,10 @@ class MonocularFrameBuilder final : public FrameBuilder {
 
   cv::Mat depth_image(const RgbdFrame&) override { return {}; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
-              const cv::Mat&) override {
+  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+              const Eigen::Vector3d& angular_velocity) override {
     return Frame(id, frame.timestamp, std::move(features.keypoints),
-                 std::move(features.descriptors), cv::Mat(), camera_, pyramid_);
+                 std::move(features.descriptors), cv::Mat(), camera_, pyramid_, angular_velocity);
   }
 
   std::unique_ptr<MapInitializer> make_map_initializer(const TrackerOptions&) const override {

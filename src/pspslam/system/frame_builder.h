@@ -47,9 +47,10 @@ class FrameBuilder {
 
   // The tracked frame from the features left after dynamic removal (an order-preserving subset
   // of the extracted ones). `depth` is what depth_image() returned, or empty when no dynamic
-  // pipeline runs.
+  // pipeline runs. `angular_velocity` (rad/s, camera frame): the tracker's, for the
+  // rolling-shutter correction of a camera that has one (map/frame.h).
   virtual Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
-                      const cv::Mat& depth) = 0;
+                      const cv::Mat& depth, const Eigen::Vector3d& angular_velocity) = 0;
 
   // How the map starts: one frame with depth (RGB-D, stereo) or two views (monocular).
   virtual std::unique_ptr<MapInitializer> make_map_initializer(

@@ -267,7 +267,8 @@ FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
   if (gray.empty()) cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
   OrbFeatures features;
   frame_builder_->extract(frame, gray, dynamic_mask, features);
-  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), {});
+  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), {},
+                                              tracker_->angular_velocity());
   report.extraction_ms = milliseconds_since(start);
   const double cpu_tracking_start = thread_cpu_ms();
   report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
@@ -324,7 +325,8 @@ FrameReport System::process(const RgbdFrame& frame) {
   dynamic_->remove_dynamic(depth, frame_builder_->keypoint_depths(), semantic_mask, features,
                            report.dynamic, fates);
   const auto frame_start = std::chrono::steady_clock::now();
-  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), depth);
+  Frame tracked_frame = frame_builder_->build(next_frame_id_++, frame, std::move(features), depth,
+                                              tracker_->angular_velocity());
   report.extraction_ms += milliseconds_since(frame_start);
   report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
 

@@ -45,6 +45,13 @@ struct TrackerOptions {
   // 8 losses), and 1 mm / 0.05° raised the ATE by 2–4 mm: the prior trades jitter for wander.
   double motion_prior_sigma_rotation = 0.0;
   double motion_prior_sigma_translation = 0.0;
+  // Rolling-shutter cameras: how far (rad/s) a frame's rotation rate may be from the previous
+  // frame's before the image must show it (the prior of optimize/rolling_shutter_pose.h): 0.03
+  // rad/s in 33 ms is a hand-held angular acceleration of ~50 deg/s^2. 0.1 let the weakly seen
+  // tilt rate follow noise (Bonn: 12 deg/s rms measured where the poses turn at 4) and lost the
+  // dev-clip panel's final trajectory in 6 of 9 cells; 0.03 won 9 of 9 online, 6 of 9 final
+  // (docs/benchmarks.md, "Rolling shutter").
+  double rotation_rate_sigma = 0.03;
   RelocalizerOptions relocalizer;
 };
 
@@ -126,6 +133,11 @@ class Tracker {
   void on_map_corrected();
   // The latest tracked pose (T_world_camera), corrected like the tracker's own state.
   std::optional<Pose> last_tracked_world_pose() const;
+  // The camera's rotation rate (rad/s, in its own frame) that a rolling-shutter camera's last
+  // tracked frame was measured to turn at (optimize/rolling_shutter_pose.h); zero for a global
+  // shutter, before the first tracked frame and after a lost one. The next frame's keypoints are
+  // moved with it (the motion model's assumption; camera/rolling_shutter.h).
+  const Eigen::Vector3d& angular_velocity() const { return angular_velocity_; }
   // The frame track() handled last (its map_points: the matches kept after pose optimisation,
   // outliers cleared); null before the first.
   const Frame* last_frame() const { return last_frame_ ? &*last_frame_ : nullptr; }
@@ -151,6 +163,7 @@ class Tracker {
   bool relocalize(Frame& frame);
   bool track_local_map(Frame& frame);
   void maybe_insert_keyframe(Frame& frame, TrackResult& result);
+  void measure_rotation_rate(Frame& frame);
 
   // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
   int optimize_frame_pose(Frame& frame);
@@ -165,6 +178,9 @@ class Tracker {
 
   std::optional<Frame> last_frame_;  // the previous frame (tracked or not)
   std::optional<Pose> velocity_;     // T_current_last of the last two tracked frames
+  // The rotation rate measured on the last tracked frame (rolling shutter only), rad/s.
+  Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();
+  std::vector<double> row_times_;  // per observation of measure_rotation_rate (reused)
   // The constant-velocity prediction of the frame being tracked, as a prior for its pose-only
   // optimisations (set only when it was tracked with the motion model and a prior is configured).
   std::optional<PosePrior> motion_prior_;

@@ -14,26 +14,12 @@ import argparse
 
 import numpy as np
 
-
-def load(path):
-    poses = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        values = [float(x) for x in line.split()]
-        poses[round(values[0], 4)] = np.array(values[1:4])
-    return poses
+from tum_numpy import load_positions, umeyama
 
 
 def ate_mm(P, Q, with_scale):
-    mp, mq = P.mean(0), Q.mean(0)
-    X, Y = P - mp, Q - mq
-    U, S, Vt = np.linalg.svd(X.T @ Y / len(P))
-    D = np.eye(3)
-    D[2, 2] = np.sign(np.linalg.det(Vt.T @ U.T))
-    R = Vt.T @ D @ U.T
-    s = (S * np.diag(D)).sum() / (X ** 2).sum(1).mean() if with_scale else 1.0
-    errors = np.linalg.norm((s * (R @ X.T)).T - Y, axis=1)
+    s, R, t = umeyama(P, Q, with_scale)
+    errors = np.linalg.norm((s * (R @ P.T)).T + t - Q, axis=1)
     return np.sqrt((errors ** 2).mean()) * 1000
 
 
@@ -44,9 +30,9 @@ def main():
     parser.add_argument("b")
     parser.add_argument("--sim3", action="store_true")
     args = parser.parse_args()
-    ground_truth = load(args.groundtruth)
+    ground_truth = load_positions(args.groundtruth, 4)
     stamps = np.array(sorted(ground_truth))
-    a, b = load(args.a), load(args.b)
+    a, b = load_positions(args.a, 4), load_positions(args.b, 4)
 
     def truth(stamp):
         i = int(np.argmin(np.abs(stamps - stamp)))

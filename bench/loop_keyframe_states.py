@@ -17,15 +17,7 @@ import argparse
 
 import numpy as np
 
-
-def load(path):
-    poses = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        values = [float(x) for x in line.split()]
-        poses[values[0]] = np.array(values[1:4])
-    return poses
+from tum_numpy import load_positions, umeyama
 
 
 def associate(ground_truth, estimate):
@@ -38,17 +30,6 @@ def associate(ground_truth, estimate):
     return pairs
 
 
-def alignment(P, Q, with_scale):
-    """s, R, t with Q ≈ s R P + t (Umeyama)."""
-    mp, mq = P.mean(0), Q.mean(0)
-    U, S, Vt = np.linalg.svd((P - mp).T @ (Q - mq) / len(P))
-    D = np.eye(3)
-    D[2, 2] = np.sign(np.linalg.det(Vt.T @ U.T))
-    R = Vt.T @ D @ U.T
-    s = (S * np.diag(D)).sum() / ((P - mp) ** 2).sum(1).mean() if with_scale else 1.0
-    return s, R, mq - s * R @ mp
-
-
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("groundtruth")
@@ -58,15 +39,15 @@ def main():
     parser.add_argument("--from", dest="first", type=int, default=0)
     parser.add_argument("--to", dest="last", type=int, default=10**9)
     args = parser.parse_args()
-    ground_truth = load(args.groundtruth)
-    final = associate(ground_truth, load(args.final_keyframes))
-    s, R, t = alignment(np.array([p for _, p, _ in final]), np.array([q for _, _, q in final]),
+    ground_truth = load_positions(args.groundtruth)
+    final = associate(ground_truth, load_positions(args.final_keyframes))
+    s, R, t = umeyama(np.array([p for _, p, _ in final]), np.array([q for _, _, q in final]),
                         args.sim3)
     for path in [args.final_keyframes] + args.states:
-        pairs = associate(ground_truth, load(path))
+        pairs = associate(ground_truth, load_positions(path))
         P = np.array([p for _, p, _ in pairs])
         Q = np.array([q for _, _, q in pairs])
-        s_own, R_own, t_own = alignment(P, Q, args.sim3)
+        s_own, R_own, t_own = umeyama(P, Q, args.sim3)
         own = np.linalg.norm((s_own * (R_own @ P.T)).T + t_own - Q, axis=1) * 1000
         in_final = np.linalg.norm((s * (R @ P.T)).T + t - Q, axis=1) * 1000
         window = [e for (frame, _, _), e in zip(pairs, in_final) if args.first <= frame <= args.last]

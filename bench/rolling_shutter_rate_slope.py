@@ -17,20 +17,7 @@ import sys
 
 import numpy as np
 
-
-def rotation(q):
-    x, y, z, w = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
-def log(R):
-    angle = np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))
-    if angle < 1e-9:
-        return np.zeros(3)
-    return angle / (2 * np.sin(angle)) * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0],
-                                                   R[1, 0] - R[0, 1]])
+from tum_numpy import rotation, so3_log
 
 
 def main():
@@ -48,7 +35,7 @@ def main():
         if abs(stamps[i] - t) > 1e-3 or i - h < 0 or i + h >= len(stamps):
             continue
         turn = R_world_camera[i - h].T @ R_world_camera[i + h]
-        pose.append(log(turn) / (stamps[i + h] - stamps[i - h]))
+        pose.append(so3_log(turn) / (stamps[i + h] - stamps[i - h]))
         image.append([wx, wy, wz])
     image, pose = np.array(image), np.array(pose)
     print(f"{len(image)} frames; rates in deg/s")

@@ -6,10 +6,7 @@ namespace pspslam {
 
 RollingShutterCorrection::RollingShutterCorrection(const PinholeCamera& camera, double readout_s,
                                                    const Eigen::Vector3d& angular_velocity)
-    : camera_(camera),
-      seconds_per_row_(readout_s / camera.height),
-      middle_row_(0.5 * camera.height),
-      rate_(angular_velocity.norm()) {
+    : camera_(camera), readout_s_(readout_s), rate_(angular_velocity.norm()) {
   active_ = readout_s != 0.0 && rate_ > 0.0;
   if (active_) axis_ = angular_velocity / rate_;
 }
@@ -23,8 +20,7 @@ cv::Point2f RollingShutterCorrection::apply(cv::Point2f undistorted, float senso
 void RollingShutterCorrection::apply(cv::Point2f& undistorted, float sensor_row,
                                      float& depth) const {
   if (!active_) return;
-  // Row v covers [v, v + 1) in pixel-centre coordinates' terms; v + 0.5 is its centre.
-  const double dt = (sensor_row + 0.5 - middle_row_) * seconds_per_row_;
+  const double dt = rolling_shutter_row_time(readout_s_, camera_.height, sensor_row);
   const Eigen::AngleAxisd turn(rate_ * dt, axis_);
   const double z = depth > 0.0f ? depth : 1.0;
   const Eigen::Vector3d seen = turn * camera_.unproject({undistorted.x, undistorted.y}, z);

@@ -21,6 +21,12 @@ namespace pspslam {
 // X = exp(dt [w]x) X_v from the camera at t (dt = t_v - t, w the body angular velocity), to
 // first order in the camera's motion over one readout. The translation over the same dt (a few
 // millimetres at hand-held speeds) is left out: its pixel shift is ~0.2 px at 2 m.
+// Seconds from the frame's instant (its middle row's) to the reading of `sensor_row` (a pixel
+// coordinate: row r spans [r - 1/2, r + 1/2)).
+inline double rolling_shutter_row_time(double readout_s, int rows, double sensor_row) {
+  return readout_s * ((sensor_row + 0.5) / rows - 0.5);
+}
+
 class RollingShutterCorrection {
  public:
   // `readout_s`: seconds from the first row to the last (0: global shutter, nothing moves;
@@ -41,8 +47,7 @@ class RollingShutterCorrection {
 
  private:
   const PinholeCamera& camera_;
-  double seconds_per_row_ = 0.0;
-  double middle_row_ = 0.0;
+  double readout_s_ = 0.0;
   Eigen::Vector3d axis_ = Eigen::Vector3d::UnitZ();
   double rate_ = 0.0;  // rad/s about axis_
   bool active_ = false;

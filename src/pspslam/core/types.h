@@ -19,4 +19,11 @@ struct StampedPose {
 
 using Trajectory = std::vector<StampedPose>;
 
+// [v]x, the matrix with [v]x w = v x w.
+inline Eigen::Matrix3d skew_symmetric(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 }  // namespace pspslam

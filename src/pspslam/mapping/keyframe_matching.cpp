@@ -4,6 +4,7 @@
 #include <climits>
 #include <cmath>
 
+#include "pspslam/core/types.h"
 #include "pspslam/map/descriptor.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
@@ -12,16 +13,10 @@
 namespace pspslam {
 namespace {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 // F21 with x2ᵀ F21 x1 = 0 for pixels x1 in `first`, x2 in `second`.
 Eigen::Matrix3d fundamental_matrix(const KeyFrame& first, const KeyFrame& second) {
   const Pose T_21 = second.T_camera_world() * first.T_world_camera();
-  const Eigen::Matrix3d essential = skew(T_21.translation()) * T_21.linear();
+  const Eigen::Matrix3d essential = skew_symmetric(T_21.translation()) * T_21.linear();
   const PinholeCamera& pinhole = first.camera().pinhole;
   Eigen::Matrix3d K_inv = Eigen::Matrix3d::Identity();
   K_inv(0, 0) = 1.0 / pinhole.fx;

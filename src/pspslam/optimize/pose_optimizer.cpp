@@ -44,8 +44,7 @@ Pose apply_update(const std::array<double, 6>& delta, const Pose& base) {
 // Left Jacobian of SO(3): Exp(ω + dω) ≈ Exp(J_l(ω) dω) Exp(ω).
 Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& omega) {
   const double angle = omega.norm();
-  Eigen::Matrix3d skew;
-  skew << 0.0, -omega.z(), omega.y(), omega.z(), 0.0, -omega.x(), -omega.y(), omega.x(), 0.0;
+  const Eigen::Matrix3d skew = skew_symmetric(omega);
   if (angle < 1e-8) return Eigen::Matrix3d::Identity() + 0.5 * skew;
   const double angle2 = angle * angle;
   return Eigen::Matrix3d::Identity() + (1.0 - std::cos(angle)) / angle2 * skew +
@@ -130,10 +129,7 @@ class FrameReprojectionCost final : public ceres::CostFunction {
     output = residual;
     if (jacobian_out != nullptr) {
       // ∂p_c/∂ω = −[p_c]× J_l(ω), ∂p_c/∂v = I.
-      Eigen::Matrix3d minus_skew;
-      minus_skew << 0.0, point_camera.z(), -point_camera.y(),  //
-          -point_camera.z(), 0.0, point_camera.x(),            //
-          point_camera.y(), -point_camera.x(), 0.0;
+      const Eigen::Matrix3d minus_skew = -skew_symmetric(point_camera);
       Eigen::Map<Eigen::Matrix<double, kResiduals, 6, Eigen::RowMajor>> jacobian(jacobian_out);
       d_residual_d_point *= scaling.jacobian;
       jacobian.template leftCols<3>() = d_residual_d_point * (minus_skew * left_jacobian);

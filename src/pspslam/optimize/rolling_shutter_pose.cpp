@@ -8,12 +8,6 @@
 namespace pspslam {
 namespace {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 using Matrix9 = Eigen::Matrix<double, 9, 9>;
 using Vector9 = Eigen::Matrix<double, 9, 1>;
 
@@ -25,7 +19,7 @@ bool accumulate(const StereoProjection& model, const PoseObservation& observatio
                 double& cost) {
   const Eigen::Vector3d p = pose * observation.point_world;
   // To first order in rho dt (a few milliradians): Exp(-dt [rho]x) ~ I - dt [rho]x.
-  const Eigen::Matrix3d turn = Eigen::Matrix3d::Identity() - dt * skew(rho);
+  const Eigen::Matrix3d turn = Eigen::Matrix3d::Identity() - dt * skew_symmetric(rho);
   const Eigen::Vector3d seen = turn * p;
   Measurement<kResiduals> measured;
   measured.template head<2>() = observation.pixel;
@@ -38,9 +32,10 @@ bool accumulate(const StereoProjection& model, const PoseObservation& observatio
   }
   Eigen::Matrix<double, kResiduals, 9> J;
   // Left pose update p -> Exp(w) p + v: dp/dw = -[p]x, dp/dv = I; d(seen)/d(rho) = dt [p]x.
-  J.template leftCols<3>() = dr_dseen * turn * (-skew(p));
+  const Eigen::Matrix3d p_cross = skew_symmetric(p);
+  J.template leftCols<3>() = dr_dseen * turn * (-p_cross);
   J.template middleCols<3>(3) = dr_dseen * turn;
-  J.template rightCols<3>() = dr_dseen * (dt * skew(p));
+  J.template rightCols<3>() = dr_dseen * (dt * p_cross);
   H.noalias() += J.transpose() * J;
   g.noalias() += J.transpose() * r;
   cost += r.squaredNorm();

@@ -300,18 +300,12 @@ std::vector<Hypothesis> homography_hypotheses(const Eigen::Matrix3d& H21,
   return hypotheses;
 }
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
-
 // Sampson errors (Hartley & Zisserman eq. 11.9) of E = [t]x R on the normalised points, in pixels.
 void sampson_residuals(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                        const std::vector<Eigen::Vector3d>& x1,
                        const std::vector<Eigen::Vector3d>& x2, double focal,
                        Eigen::VectorXd& residuals) {
-  const Eigen::Matrix3d E = skew(t) * R;
+  const Eigen::Matrix3d E = skew_symmetric(t) * R;
   residuals.resize(static_cast<Eigen::Index>(x1.size()));
   for (size_t i = 0; i < x1.size(); ++i) {
     const Eigen::Vector3d Ex1 = E * x1[i];

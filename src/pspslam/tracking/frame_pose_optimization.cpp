@@ -1,9 +1,30 @@
 #include "pspslam/tracking/frame_pose_optimization.h"
 
+#include "pspslam/camera/rolling_shutter.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/map_point.h"
+#include "pspslam/optimize/rolling_shutter_pose.h"
 
 namespace pspslam {
+namespace {
+
+// The frame's matches (or only those not flagged as outliers) as pose observations.
+void gather_observations(const Frame& frame, bool inliers_only, FramePoseBuffers& buffers) {
+  buffers.observations.clear();
+  buffers.keypoint_of_observation.clear();
+  const ScalePyramid& pyramid = frame.pyramid();
+  for (int i = 0; i < frame.size(); ++i) {
+    const auto& point = frame.map_points[i];
+    if (!point || (inliers_only && frame.outlier[i])) continue;
+    const cv::KeyPoint& kp = frame.keypoints()[i];
+    buffers.observations.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
+                                    static_cast<double>(frame.right_u(i)),
+                                    pyramid.inv_sigma2[kp.octave]});
+    buffers.keypoint_of_observation.push_back(i);
+  }
+}
+
+}  // namespace
 
 Pose orthonormalized(const Pose& pose) {
   Pose out = pose;
@@ -13,23 +34,30 @@ Pose orthonormalized(const Pose& pose) {
 
 PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
                                            FramePoseBuffers& buffers, const PosePrior* prior) {
-  buffers.observations.clear();
-  buffers.keypoint_of_observation.clear();
-  const ScalePyramid& pyramid = frame.pyramid();
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& point = frame.map_points[i];
-    if (!point) continue;
-    const cv::KeyPoint& kp = frame.keypoints()[i];
-    buffers.observations.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                                    static_cast<double>(frame.right_u(i)),
-                                    pyramid.inv_sigma2[kp.octave]});
-    buffers.keypoint_of_observation.push_back(i);
-  }
+  gather_observations(frame, /*inliers_only=*/false, buffers);
   PoseOptimizationResult optimized =
       optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
                     buffers.observations, options, prior);
   frame.set_pose(orthonormalized(optimized.T_camera_world));
   return optimized;
+}
+
+Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
+                                           double sigma_rate, FramePoseBuffers& buffers) {
+  const RgbdCamera& camera = frame.camera();
+  if (camera.rolling_shutter_readout_s == 0.0) return Eigen::Vector3d::Zero();
+  gather_observations(frame, /*inliers_only=*/true, buffers);
+  buffers.row_times.clear();
+  for (const PoseObservation& observation : buffers.observations) {
+    buffers.row_times.push_back(rolling_shutter_row_time(
+        camera.rolling_shutter_readout_s, camera.pinhole.height, observation.pixel.y()));
+  }
+  const RollingShutterPose refined = refine_pose_and_rotation_rate(
+      camera.pinhole, camera.bf, options.depth_noise, frame.T_camera_world(), buffers.observations,
+      buffers.row_times, sigma_rate);
+  frame.set_pose(orthonormalized(refined.T_camera_world));
+  frame.correct_rotation_rate(refined.rate_correction);
+  return refined.rate_correction;
 }
 
 }  // namespace pspslam

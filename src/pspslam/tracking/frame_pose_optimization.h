@@ -18,6 +18,7 @@ Pose orthonormalized(const Pose& pose);
 struct FramePoseBuffers {
   std::vector<PoseObservation> observations;
   std::vector<int> keypoint_of_observation;  // frame keypoint index of observations[k]
+  std::vector<double> row_times;             // refine_frame_rotation_rate only
 };
 
 // Pose-only optimisation of `frame` on its current map point matches (every keypoint with a map
@@ -28,5 +29,12 @@ struct FramePoseBuffers {
 PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
                                            FramePoseBuffers& buffers,
                                            const PosePrior* prior = nullptr);
+
+// Rolling shutter (RgbdCamera::rolling_shutter_readout_s != 0): the pose and the rotation rate of
+// `frame` refined together on its inlier matches (optimize/rolling_shutter_pose.h, prior
+// `sigma_rate` rad/s), the pose set and the keypoints moved by the rate correction, which is
+// returned (rad/s, camera frame; zero for a global shutter, which changes nothing).
+Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
+                                           double sigma_rate, FramePoseBuffers& buffers);
 
 }  // namespace pspslam

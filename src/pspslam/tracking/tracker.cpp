@@ -1,13 +1,11 @@
 #include "pspslam/tracking/tracker.h"
 
-#include <Eigen/Geometry>
 #include <mutex>
 
 #include "pspslam/core/error.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/optimize/rolling_shutter_pose.h"
 #include "pspslam/solve/pnp_ransac.h"
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
@@ -96,7 +94,10 @@ TrackResult Tracker::track(Frame frame) {
       }
     }
     if (ok) ok = track_local_map(frame);
-    if (ok) measure_rotation_rate(frame);
+    if (ok) {
+      angular_velocity_ += refine_frame_rotation_rate(frame, options_.pose_optimizer,
+                                                      options_.rotation_rate_sigma, pose_buffers_);
+    }
     if (ok) {
       state_ = TrackingState::kOk;
       result.num_inliers = 0;
@@ -191,30 +192,6 @@ bool Tracker::initialize(Frame& frame, TrackResult& result) {
     for (const auto& keyframe : keyframes) sink_->insert_keyframe(keyframe);
   }
   return true;
-}
-
-void Tracker::measure_rotation_rate(Frame& frame) {
-  const double readout = frame.camera().rolling_shutter_readout_s;
-  if (readout == 0.0) return;
-  pose_buffers_.observations.clear();
-  row_times_.clear();
-  const ScalePyramid& pyramid = frame.pyramid();
-  const double rows = frame.camera().pinhole.height;
-  for (int i = 0; i < frame.size(); ++i) {
-    const auto& point = frame.map_points[i];
-    if (!point || frame.outlier[i]) continue;
-    const cv::KeyPoint& kp = frame.keypoints()[i];
-    pose_buffers_.observations.push_back({point->position(), Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                                          static_cast<double>(frame.right_u(i)),
-                                          pyramid.inv_sigma2[kp.octave]});
-    row_times_.push_back(readout * ((kp.pt.y + 0.5) / rows - 0.5));
-  }
-  const RollingShutterPose refined = refine_pose_and_rotation_rate(
-      frame.camera().pinhole, frame.camera().bf, options_.pose_optimizer.depth_noise,
-      frame.T_camera_world(), pose_buffers_.observations, row_times_, options_.rotation_rate_sigma);
-  frame.set_pose(orthonormalized(refined.T_camera_world));
-  frame.correct_rotation_rate(refined.rate_correction);
-  angular_velocity_ += refined.rate_correction;
 }
 
 void Tracker::restart() {

@@ -163,7 +163,6 @@ class Tracker {
   bool relocalize(Frame& frame);
   bool track_local_map(Frame& frame);
   void maybe_insert_keyframe(Frame& frame, TrackResult& result);
-  void measure_rotation_rate(Frame& frame);
 
   // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
   int optimize_frame_pose(Frame& frame);
@@ -180,7 +179,6 @@ class Tracker {
   std::optional<Pose> velocity_;     // T_current_last of the last two tracked frames
   // The rotation rate measured on the last tracked frame (rolling shutter only), rad/s.
   Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();
-  std::vector<double> row_times_;  // per observation of measure_rotation_rate (reused)
   // The constant-velocity prediction of the frame being tracked, as a prior for its pose-only
   // optimisations (set only when it was tracked with the motion model and a prior is configured).
   std::optional<PosePrior> motion_prior_;

@@ -170,6 +170,9 @@ async function loadMap(version) {
   try {
     const response = await fetch(`/api/live/map?v=${version}`);
     if (response.ok) showMap(await response.json());
+  } catch {
+    // The run ended and its server closed while this map was on its way: the last map shown
+    // stays (the event stream's error handler says whether the run finished).
   } finally {
     mapBusy = false;
     if (mapVersion !== version) loadMap(mapVersion);
@@ -250,8 +253,12 @@ function showState(state) {
 }
 
 async function control(action) {
-  const response = await fetch(`/api/${action}`, { method: 'POST' });
-  if (!response.ok) $('control-note').textContent = (await response.json()).error;
+  try {
+    const response = await fetch(`/api/${action}`, { method: 'POST' });
+    if (!response.ok) $('control-note').textContent = (await response.json()).error;
+  } catch {
+    $('control-note').textContent = `${action}: no connection to the run`;
+  }
 }
 for (const action of ['pause', 'resume', 'step'])
   $(action).addEventListener('click', () => control(action));

@@ -13,6 +13,7 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
+#include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/synth/kinect.h"
 #include "pspslam/synth/scene.h"
@@ -327,6 +328,47 @@ TEST(SynthKinect, WrittenSequenceHasMarkerGroundTruthDistortionAndIsDeterministi
     ++files;
   }
   EXPECT_EQ(files, 4u * 3u + 8u);  // + body_to_camera.txt
+}
+
+// depth.txt stamps (and names) each depth image with its own capture instant, as a Kinect driver
+// does and as the Bonn recordings show; colour, masks and ground truth keep the colour instant.
+// The pairs still associate one to one (|offset| <= 16 ms < half a frame interval).
+TEST(SynthKinect, DepthListCarriesTheDepthCaptureInstant) {
+  SynthOptions options = no_faults(3);
+  options.frames = 6;
+  options.faults.sync_offset = true;
+  const SyntheticScene scene(options);
+  const fs::path dir = testing::make_temp_dir("synth_kinect_stamps");
+  write_sequence(scene, dir);
+  const auto read_stamps = [](const fs::path& list) {
+    std::ifstream in(list);
+    std::vector<std::pair<double, std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      const size_t space = line.find(' ');
+      rows.emplace_back(std::stod(line.substr(0, space)), line.substr(space + 1));
+    }
+    return rows;
+  };
+  const auto colour = read_stamps(dir / "rgb.txt");
+  const auto depth = read_stamps(dir / "depth.txt");
+  ASSERT_EQ(colour.size(), 6u);
+  ASSERT_EQ(depth.size(), 6u);
+  int offset_frames = 0;
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(colour[i].first, scene.timestamp(i), 1e-6);
+    EXPECT_NEAR(depth[i].first - colour[i].first, scene.depth_time_offset(i), 1.5e-6) << i;
+    EXPECT_TRUE(fs::exists(dir / depth[i].second)) << depth[i].second;
+    offset_frames += std::abs(scene.depth_time_offset(i)) > 1e-3;
+  }
+  EXPECT_GE(offset_frames, 4);  // the offset is drawn per frame within +-16 ms
+
+  const RgbdSequence sequence = RgbdSequence::open(dir);
+  ASSERT_EQ(sequence.size(), 6u);
+  for (size_t i = 0; i < 6; ++i) {
+    const RgbdFrame frame = sequence.load(i);
+    EXPECT_NEAR(frame.depth_timestamp - frame.timestamp, scene.depth_time_offset(i), 1.5e-6);
+  }
 }
 
 TEST(SynthKinect, ExposureDriftsSlowlyAndStepsSometimes) {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -77,13 +78,23 @@ std::string describe(const SynthOptions& options) {
          std::to_string(options.carried_objects) + kinect_flags(options) + stereo_flags(options);
 }
 
+// The stamp of frame i's depth image: its capture instant, as a Kinect driver stamps each stream
+// (the Bonn recordings' depth stamps sit -17..+17 ms from their colour stamps, and the colour and
+// depth edges of bonn_crowd_dev shift with that difference times the image motion:
+// tools/calibration/depth_sync_check.py). Equal to the colour stamp unless kinect sync-offset.
+Timestamp depth_timestamp(const SyntheticScene& scene, size_t i) {
+  return scene.timestamp(i) + scene.depth_time_offset(i);
+}
+
+// `stamp_of(i)`: the timestamp listed (and naming the file) for frame i.
 void write_frame_list(const fs::path& dir, const std::string& list_name, const std::string& folder,
-                      const std::string& what, const SyntheticScene& scene) {
+                      const std::string& what, const SyntheticScene& scene,
+                      const std::function<Timestamp(size_t)>& stamp_of) {
   const fs::path file = dir / list_name;
   std::ofstream out = open_text(file);
   out << "# " << what << "\n# file: '" << describe(scene.options()) << "'\n# timestamp filename\n";
   for (size_t i = 0; i < scene.frame_count(); ++i) {
-    const std::string ts = format_timestamp(scene.timestamp(i));
+    const std::string ts = format_timestamp(stamp_of(i));
     out << ts << " " << folder << "/" << ts << ".png\n";
   }
   close_text(out, file);
@@ -172,7 +183,8 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
   if (scene.options().sensor == SynthSensor::kKinect) {
     out << "\nSensor: kinect, faults " << scene.options().faults.describe() << ":\n"
         << "depth noise 1.425e-3 z^2 m quantised to 1/8 px of disparity, holes (projector\n"
-        << "shadow, dark and grazing surfaces), depth captured up to +-16 ms off colour, a 30 ms\n"
+        << "shadow, dark and grazing surfaces), depth captured up to +-16 ms off colour (its\n"
+        << "stamp in depth.txt and its file name are that instant, as a Kinect driver's), a 30 ms\n"
         << "rolling shutter, motion blur, exposure changes, lens distortion (config.yaml), the\n"
         << "Bonn clip's hand-held speeds, and ground truth of a marker body:\n"
         << "body_to_camera.txt  T_body_camera for 'pspslam eval --gt-body-to-camera'\n";
@@ -345,7 +357,8 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
           const std::string name = format_timestamp(frame.timestamp) + ".png";
           write_png(dir / "rgb" / name, frame.bgr);
           frame.depth_sensor.convertTo(depth_u16, CV_16U, 5000.0);
-          write_png(dir / "depth" / name, depth_u16);
+          write_png(dir / "depth" / (format_timestamp(depth_timestamp(scene, i)) + ".png"),
+                    depth_u16);
           write_png(dir / "mask" / name, frame.labels);
           if (stereo) write_png(dir / "right" / name, right);
         }
@@ -391,14 +404,17 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
     write_info(dir, scene);
     return;
   }
-  write_frame_list(dir, "rgb.txt", "rgb", "color images", scene);
+  const auto colour_stamp = [&](size_t i) { return scene.timestamp(i); };
+  write_frame_list(dir, "rgb.txt", "rgb", "color images", scene, colour_stamp);
   write_frame_list(dir, "depth.txt", "depth",
-                   "depth maps (16-bit PNG, 5000 per metre, 0 = no reading)", scene);
+                   "depth maps (16-bit PNG, 5000 per metre, 0 = no reading)", scene,
+                   [&](size_t i) { return depth_timestamp(scene, i); });
   write_frame_list(dir, "mask.txt", "mask",
-                   "ground-truth labels (0 static, 15 person, 100 carried object)", scene);
+                   "ground-truth labels (0 static, 15 person, 100 carried object)", scene,
+                   colour_stamp);
   if (stereo) {
     write_frame_list(dir, "right.txt", "right",
-                     "rectified right images (8-bit grey) of the stereo pair", scene);
+                     "rectified right images (8-bit grey) of the stereo pair", scene, colour_stamp);
     save_config(dir / "config_rgbd.yaml", scene.rgbd_system_config());
   }
   save_config(dir / "config.yaml", scene.system_config());

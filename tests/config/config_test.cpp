@@ -121,6 +121,8 @@ TEST(Config, AllPresetsLoad) {
   EXPECT_DOUBLE_EQ(bonn.camera.pinhole.cy, 237.756098);
   EXPECT_DOUBLE_EQ(bonn.camera.pinhole.distortion[0], 0.039903);
   EXPECT_DOUBLE_EQ(bonn.camera.depth_factor, 5000.0);
+  EXPECT_EQ(bonn.camera.depth_noise, CameraConfig::DepthNoise::kinect_v1);
+  EXPECT_DOUBLE_EQ(bonn.camera.depth_noise_scale, 16.0);
   struct Expected {
     const char* file;
     const char* name;

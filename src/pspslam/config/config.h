@@ -36,10 +36,10 @@ struct CameraConfig {
   double depth_threshold = 4.0;  // metres: closer points are "close" (reliable) points
   // How a depth reading is weighed against the pixel in pose optimisation and bundle adjustment
   // (optional keys `depth_noise: none | kinect_v1`, `depth_noise_scale`). none: ORB-SLAM2's
-  // virtual right coordinate, as firm as a pixel (robust to depth that is misregistered or out of
-  // sync with colour, as in bonn_crowd_dev). kinect_v1: a disparity row whitened by the Kinect v1
-  // axial noise model times depth_noise_scale (optimize/depth_noise_model.h); right for depth
-  // registered and synchronised with colour, e.g. the synthetic sequences.
+  // virtual right coordinate, as firm as a pixel. kinect_v1: a disparity row whitened by the
+  // Kinect v1 axial noise model times depth_noise_scale (optimize/depth_noise_model.h): 2 for
+  // depth registered and synchronised with colour (the synthetic sequences), 16 for the Bonn
+  // sensor's real depth (config/bonn.yaml).
   enum class DepthNoise { none, kinect_v1 };
   DepthNoise depth_noise = DepthNoise::none;
   double depth_noise_scale = 2.0;

@@ -20,9 +20,11 @@ namespace pspslam {
 // Off by default, switched on per sensor by the camera config (`depth_noise: kinect_v1`, with
 // `depth_noise_scale` as `scale` for both pose-only optimisation and BA). On the synthetic
 // static sequences (depth registered and synchronised with colour) scale 2 gives ATE 4.1-4.2 mm
-// vs 14.3-17.8 mm with the u_r row (seeds 1 and 7, 600 frames). On bonn_crowd_dev (real depth,
-// people walking) it raised `--dynamic full` ATE from 0.024 m to 0.12 m and `off` from 0.20 m to
-// 0.42 m (one run each, 2026-11-21), so the bonn and TUM presets keep it off.
+// vs 14.3-17.8 mm with the u_r row (seeds 1 and 7, 600 frames). Real depth needs a looser model:
+// on bonn_crowd_dev scale 2 was 5x worse than the u_r row (2026-11-21), while since the depth
+// registration shift and the rolling-shutter correction scale 16 beats it in all 9 dev-clip
+// cells of the accuracy panel (config/bonn.yaml; docs/benchmarks.md, "Depth weighting on the
+// real clip"). The TUM presets keep the u_r row: not measured.
 struct DepthNoiseModel {
   bool enabled = false;
   double constant = 0.0012;   // metres

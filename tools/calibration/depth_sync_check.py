@@ -26,40 +26,14 @@ search window and the image motion is far from one flow (correlation 0.20).
 """
 import argparse
 import os
+import sys
+from pathlib import Path
 
 import cv2
 import numpy as np
 
-
-def read_list(path):
-    rows = [line.split() for line in open(path) if line.strip() and not line.startswith("#")]
-    return [(float(r[0]), r[1]) for r in rows]
-
-
-def depth_edges(depth, vertical_only):
-    valid = cv2.erode((depth > 0).astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
-    gx = np.abs(cv2.Sobel(depth, cv2.CV_32F, 1, 0))
-    jump = np.hypot(gx, cv2.Sobel(depth, cv2.CV_32F, 0, 1))
-    edges = (jump / (depth + 1e-3) > 0.15) & valid
-    if vertical_only:  # edges across which depth changes left to right carry a horizontal shift
-        edges &= gx > 0.7 * jump
-    return edges.astype(np.float32)
-
-
-def gradient(gray):
-    g = gray.astype(np.float32)
-    magnitude = np.hypot(cv2.Sobel(g, cv2.CV_32F, 1, 0), cv2.Sobel(g, cv2.CV_32F, 0, 1))
-    return magnitude / (magnitude.mean() + 1e-6)
-
-
-def score(edges, grad, dx, dy):
-    # shifted(u, v) = grad(u + dx, v + dy): the colour edge dx, dy away from the depth edge.
-    height, width = grad.shape
-    warp = np.float32([[1, 0, dx], [0, 1, dy]])
-    shifted = cv2.warpAffine(grad, warp, (width, height),
-                             flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
-    inner = (slice(10, -10), slice(10, -10))
-    return (edges[inner] * shifted[inner]).sum() / edges.sum()
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from depth_registration_shift import depth_edges, gradient, read_list, score  # noqa: E402
 
 
 def main():
@@ -97,7 +71,7 @@ def main():
         found = pair(k)
         if found is None:
             continue
-        edges = depth_edges(found[1], False)
+        edges = depth_edges(found[1])
         if edges.sum() == 0:
             continue
         grad = gradient(gray(k))
@@ -114,7 +88,7 @@ def main():
         if found is None:
             continue
         delta, d = found
-        edges = depth_edges(d, True)
+        edges = depth_edges(d, vertical_only=True)
         if edges.sum() < 200:
             continue
         grad = gradient(gray(k))

@@ -317,8 +317,6 @@ TEST(OrbExtractor, ScaleTables) {
     const double scale = std::pow(1.2, level);
     EXPECT_NEAR(extractor.scale_factors()[level], scale, 1e-5);
     EXPECT_NEAR(extractor.inv_scale_factors()[level], 1.0 / scale, 1e-6);
-    EXPECT_NEAR(extractor.level_sigma2()[level], scale * scale, 1e-5);
-    EXPECT_NEAR(extractor.inv_level_sigma2()[level], 1.0 / (scale * scale), 1e-6);
   }
   const std::vector<int>& share = extractor.features_per_level();
   EXPECT_EQ(share[0], 217);  // 1000 (1 - 1/1.2) / (1 - 1.2^-8)

@@ -57,14 +57,10 @@ OrbExtractor::OrbExtractor(const OrbConfig& config, const BriefPattern& pattern)
   const int n_levels = config.n_levels;
   scale_factors_.resize(n_levels);
   inv_scale_factors_.resize(n_levels);
-  level_sigma2_.resize(n_levels);
-  inv_level_sigma2_.resize(n_levels);
   double scale = 1.0;
   for (int level = 0; level < n_levels; ++level) {
     scale_factors_[level] = static_cast<float>(scale);
     inv_scale_factors_[level] = static_cast<float>(1.0 / scale);
-    level_sigma2_[level] = static_cast<float>(scale * scale);
-    inv_level_sigma2_[level] = static_cast<float>(1.0 / (scale * scale));
     scale *= config.scale_factor;
   }
 

@@ -49,10 +49,6 @@ class OrbExtractor {
   // scale_factors()[l] = scale_factor^l: level-0 coordinate = level coordinate * scale.
   const std::vector<float>& scale_factors() const { return scale_factors_; }
   const std::vector<float>& inv_scale_factors() const { return inv_scale_factors_; }
-  // Variance of a keypoint position measured on level l, in level-0 pixels^2 (scale^2): the
-  // weight of reprojection errors in optimisation and the tolerance of matching windows.
-  const std::vector<float>& level_sigma2() const { return level_sigma2_; }
-  const std::vector<float>& inv_level_sigma2() const { return inv_level_sigma2_; }
   // How many of config().n_features each level aims for: each level gets 1/scale_factor of the
   // previous level's share (217, 181, 151, ... for the defaults), summing to n_features.
   const std::vector<int>& features_per_level() const { return features_per_level_; }
@@ -95,8 +91,6 @@ class OrbExtractor {
   OrbConfig config_;
   std::vector<float> scale_factors_;
   std::vector<float> inv_scale_factors_;
-  std::vector<float> level_sigma2_;
-  std::vector<float> inv_level_sigma2_;
   std::vector<int> features_per_level_;
   // umax_[v]: half-width of the circular orientation patch at row offset v.
   std::array<int, 16> umax_{};

@@ -67,7 +67,6 @@ class TrajectoryWriter {
   }
 
   size_t count() const { return count_; }
-  const std::filesystem::path& path() const { return path_; }
   // Truncates the file back to its header (a monocular map restarted in another world frame:
   // the poses written so far do not belong with the ones to come).
   void clear();

@@ -36,7 +36,6 @@ class FrameLog {
   // A monocular map was restarted (TrackResult::restart_due) by the frame just written: the
   // poses tracked in it leave trajectory.txt and are listed in lost_frames.txt as `restarted`.
   void forget_poses();
-  const std::filesystem::path& trajectory_path() const { return trajectory_.path(); }
 
  private:
   TrajectoryWriter trajectory_;

@@ -338,11 +338,6 @@ HttpReply LiveViewer::control(bool (LiveViewer::*action)()) {
   return {409, "application/json", share(json{{"ok", false}, {"error", why}}.dump())};
 }
 
-std::uint64_t LiveViewer::frames_published() const {
-  std::lock_guard lock(mutex_);
-  return frame_version_;
-}
-
 std::string LiveViewer::state_json() const {
   return json{{"paused", paused_},
               {"waiting", waiting_},

@@ -65,9 +65,6 @@ class LiveViewer final : public RunObserver {
   bool resume();
   bool step();
 
-  // Snapshots published so far (frame images encoded); for tests.
-  std::uint64_t frames_published() const;
-
  private:
   struct FrameSnapshot;
   struct MapSnapshot;

@@ -122,10 +122,23 @@ TEST_F(Fakenect, CameraRunMatchesTheFolderRun) {
                                (root() / (folder + "_out")).string() + common);
     ASSERT_EQ(run.status, 0) << run.output;
   }
-  const Result camera = replayed(
-      root() / "dump", "run --camera freenect --config " + (root() / "seq/config.yaml").string() +
-                           " --max-frames " + std::to_string(kFrames) + " --out " +
-                           (root() / "camera_out").string() + common);
+  // A camera run is live: a frame that arrives while the previous one is still being tracked is
+  // dropped, and the replay then ends before --max-frames (exit 4). The dump's 4 frames/s leave
+  // room for ctest's other tests; a machine loaded far beyond that can still drop one, which is
+  // the camera behaving as it should, so such a run is repeated (at most twice) rather than
+  // compared.
+  Result camera;
+  for (int attempt = 1;; ++attempt) {
+    camera = replayed(root() / "dump", "run --camera freenect --config " +
+                                           (root() / "seq/config.yaml").string() +
+                                           " --max-frames " + std::to_string(kFrames) + " --out " +
+                                           (root() / "camera_out").string() + common);
+    const auto stats_file = root() / "camera_out/stats.json";
+    if (attempt == 3 || !std::filesystem::exists(stats_file) ||
+        read_json(stats_file)["input"]["dropped_frames"] == 0)
+      break;
+    std::cout << "camera run " << attempt << " dropped a frame (machine load); running it again\n";
+  }
   ASSERT_EQ(camera.status, 0) << camera.output;
   EXPECT_TRUE(contains(camera.output,
                        "camera:       freenect:0 (Kinect v1 through libfreenect, "

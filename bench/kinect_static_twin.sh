@@ -2,13 +2,19 @@
 # #15 target "synthetic --sensor kinect sequences: full <= 1.3x its static twin": the panel's four
 # hand-held kinect cells (seed people: 21 2, 22 3, 23 4, 26 4; 240 frames) and each one's static
 # twin (same seed and motion, --bodies 0), `pspslam run --dynamic full` on both; ATE RMSE (mm) of
-# trajectory.txt and trajectory_refined.txt with the marker body moved onto the camera.
-# usage: PSPSLAM=build/apps/pspslam WORK=/tmp/kinect_twin bench/kinect_static_twin.sh
+# trajectory.txt and trajectory_refined.txt with the marker body moved onto the camera, then the
+# ratio of each sequence to its twin and how many are within 1.3x.
+# usage: PSPSLAM=build/apps/pspslam WORK=/tmp/kinect_twin [RUN_FLAGS="--model M"] \
+#        bench/kinect_static_twin.sh
+# (RUN_FLAGS go to every run, twins included; runs already in WORK are reused, so give each
+# variant its own WORK.)
 set -euo pipefail
 B=${PSPSLAM:-build/apps/pspslam}
 W=${WORK:-/tmp/kinect_twin}
 PY=${PYTHON:-/usr/bin/python3}
 mkdir -p "$W"
+results=$W/results.txt
+: >"$results"
 for spec in "21 2" "22 3" "23 4" "26 4"; do
   set -- $spec
   seed=$1
@@ -18,12 +24,34 @@ for spec in "21 2" "22 3" "23 4" "26 4"; do
     [ -f "$seq/groundtruth.txt" ] || "$B" -q synth --out "$seq" --frames 240 --bodies "$bodies" \
       --seed "$seed" --trajectory handheld --sensor kinect --threads 1 >/dev/null
     out=$W/run_${seed}_b$bodies
+    # shellcheck disable=SC2086  # RUN_FLAGS is a list of flags
     [ -f "$out/stats.json" ] || "$B" -q run --sequence "$seq" --out "$out" --dynamic full \
-      >"$W/log_${seed}_b$bodies.txt" 2>&1
+      ${RUN_FLAGS:-} >"$W/log_${seed}_b$bodies.txt" 2>&1
     for f in trajectory.txt trajectory_refined.txt; do
-      echo "seed $seed bodies $bodies $f $("$B" -q eval --gt "$seq/groundtruth.txt" --est "$out/$f" \
+      line="seed $seed bodies $bodies $f $("$B" -q eval --gt "$seq/groundtruth.txt" --est "$out/$f" \
         --gt-body-to-camera "$seq/body_to_camera.txt" --json | "$PY" -c \
         'import json,sys; e=json.load(sys.stdin)["ate"]["error_m"]; print(round(e["rmse"]*1e3,2), e["count"])')"
+      echo "$line"
+      echo "$line" >>"$results"
     done
   done
 done
+"$PY" - "$results" <<'EOF'
+import sys
+ate = {}
+for line in open(sys.argv[1]):
+    _, seed, _, bodies, name, rmse, _ = line.split()
+    ate[(seed, bodies != "0", name)] = float(rmse)
+print("\n| seed | online: full / twin = ratio | refined: full / twin = ratio |\n|---|---|---|")
+within = {"trajectory.txt": 0, "trajectory_refined.txt": 0}
+seeds = sorted({key[0] for key in ate})
+for seed in seeds:
+    cells = []
+    for name in within:
+        full, twin = ate[(seed, True, name)], ate[(seed, False, name)]
+        within[name] += full <= 1.3 * twin
+        cells.append(f"{full:.2f} / {twin:.2f} = {full / twin:.2f}")
+    print(f"| {seed} | {cells[0]} | {cells[1]} |")
+print(f"\nwithin 1.3x: online {within['trajectory.txt']} of {len(seeds)}, "
+      f"refined {within['trajectory_refined.txt']} of {len(seeds)}")
+EOF

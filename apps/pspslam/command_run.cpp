@@ -140,7 +140,8 @@ struct RunFlags {
   size_t max_frames = 0;
   bool no_local_mapping = false;
   std::string dynamic = "auto";
-  std::string model;  // empty: the shipped model
+  std::string model;           // empty: the shipped model
+  std::string semantic_masks;  // empty: the network segments the frames
   bool realtime = false;
   std::string preload = "auto";
   int background_nice = -1;  // -1: kLiveBackgroundNice for live runs, else 0
@@ -200,7 +201,18 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   SystemOptions& system = options.system;
   DynamicOptions& dynamic = system.dynamic;
   dynamic.model = user_or_default(flags.model, data_dir() / "models/pspnet/pspnet.yaml");
-  dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
+  if (flags.semantic_masks.empty()) {
+    dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
+  } else {
+    // The masks stand in for the network: they need a mode with a semantic half (auto: full).
+    dynamic.mode = flags.dynamic == "auto" ? DynamicMode::full
+                                           : parse_dynamic_mode(flags.dynamic, "--dynamic");
+    if (!uses_semantics(dynamic.mode)) {
+      throw Error("--semantic-masks replaces the network's masks, but --dynamic " + flags.dynamic +
+                  " uses none (use semantic, full or exhaustive)");
+    }
+    dynamic.semantic_masks = flags.semantic_masks;
+  }
   system.local_mapping = !flags.no_local_mapping;
   system.synchronous_local_mapping = !flags.realtime;
   const bool live = flags.realtime || !flags.camera.empty();
@@ -375,6 +387,12 @@ Command add_run_command(CLI::App& root) {
                   "with the camera by the frame-to-frame homographies")
       ->check(in_range(1, 30))
       ->capture_default_str();
+  app->add_option("--semantic-masks", flags->semantic_masks,
+                  "read each frame's semantic mask from this folder instead of running the "
+                  "network: DIR/<colour image name>.png, 8-bit, non-zero = dynamic (what "
+                  "--save-masks writes; a synth sequence's mask/ folder); grown by --mask-margin")
+      ->check(CLI::ExistingDirectory)
+      ->needs(sequence);
   app->add_option("--mask-margin", flags->mask_margin,
                   "dilation of the semantic dynamic mask (pixels)")
       ->check(in_range(0, 100))

@@ -923,6 +923,88 @@ TEST(CliRun, SaveMasksAndOverlaysPerProcessedFrame) {
   EXPECT_GT(iou, 0.5);
 }
 
+// `--semantic-masks DIR` stands in for the network: a synthetic sequence's own person labels go
+// in, and the run's saved masks are exactly those labels (semantic mode, no margin); the saved
+// masks read back by a second run give the same trajectory.
+TEST(CliRun, SemanticMasksFromAFolderReplaceTheNetwork) {
+  const auto dir = testing::make_temp_dir("cli_semantic_masks");
+  const auto seq = dir / "seq";
+  const Result synth = pspslam("synth --out " + seq.string() + " --frames 30 --bodies 2 --seed 5");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const std::string common =
+      " --dynamic semantic --max-frames 12 --mask-margin 0 --loop-closing off";
+  const Result first = pspslam("run --sequence " + seq.string() + " --out " + (dir / "a").string() +
+                               common + " --semantic-masks " + (seq / "mask").string() +
+                               " --save-masks " + (dir / "saved").string());
+  ASSERT_EQ(first.status, 0) << first.output;
+  EXPECT_TRUE(contains(first.output, "dynamic:      semantic (semantic masks from " +
+                                         (seq / "mask").string() + "), deterministic"))
+      << first.output;
+  const std::vector<std::string> rgb = listed_files(seq / "rgb.txt");
+  const std::vector<std::string> truth = listed_files(seq / "mask.txt");
+  int person_pixels = 0;
+  for (size_t i = 0; i < 12; ++i) {
+    const std::string name = std::filesystem::path(rgb[i]).stem().string() + ".png";
+    const cv::Mat saved = cv::imread((dir / "saved" / name).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat labels = cv::imread((seq / truth[i]).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(saved.empty()) << name;
+    ASSERT_EQ(saved.size(), labels.size()) << name;
+    EXPECT_EQ(cv::countNonZero(saved != ((labels != 0) & 255)), 0) << name;
+    person_pixels += cv::countNonZero(labels);
+  }
+  EXPECT_GT(person_pixels, 12 * 2000);  // people are in view
+  const Result second =
+      pspslam("run --sequence " + seq.string() + " --out " + (dir / "b").string() + common +
+              " --semantic-masks " + (dir / "saved").string());
+  ASSERT_EQ(second.status, 0) << second.output;
+  EXPECT_EQ(read_text(dir / "b" / "trajectory.txt"), read_text(dir / "a" / "trajectory.txt"));
+}
+
+TEST(CliRun, SemanticMasksThatDoNotFitAreClearErrors) {
+  const auto dir = testing::make_temp_dir("cli_semantic_masks_bad");
+  const auto seq = dir / "seq";
+  const Result synth = pspslam("synth --out " + seq.string() + " --frames 3 --bodies 1 --seed 5");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  std::filesystem::create_directories(dir / "masks");
+  const std::string run = "run --sequence " + seq.string() + " --out " + (dir / "out").string() +
+                          " --semantic-masks " + (dir / "masks").string();
+  Result r = pspslam(run + " --dynamic geometry");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: --semantic-masks replaces the network's masks, but --dynamic geometry uses "
+            "none (use semantic, full or exhaustive)\n");
+
+  const std::string first = listed_files(seq / "rgb.txt")[0];
+  const auto expected_file =
+      dir / "masks" / (std::filesystem::path(first).stem().string() + ".png");
+  r = pspslam(run);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: " + expected_file.string() +
+                                     ": no semantic mask for frame " + first +
+                                     " (--semantic-masks: an 8-bit PNG per frame, named after "
+                                     "its colour image)\n"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "dynamic:      full (semantic masks from")) << r.output;
+
+  ASSERT_TRUE(cv::imwrite(expected_file.string(), cv::Mat(10, 12, CV_8UC1, cv::Scalar(0))));
+  r = pspslam(run);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output, "error: " + expected_file.string() +
+                                     ": the mask is 12x10 but "
+                                     "frame " +
+                                     first + " is 640x480\n"))
+      << r.output;
+  // The run stopped at its first frame: its trajectory file is there, header only.
+  EXPECT_TRUE(read_tum_trajectory(dir / "out" / "trajectory.txt").empty());
+
+  r = pspslam("run --sequence " + seq.string() + " --out " + (dir / "out").string() +
+              " --semantic-masks " + (dir / "absent").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.output,
+                       "--semantic-masks: Directory does not exist: " + (dir / "absent").string()))
+      << r.output;
+}
+
 TEST(CliRun, SaveMasksUnderAFileIsRefusedBeforeTheRun) {
   const auto dir = testing::make_temp_dir("cli_masks_file");
   std::ofstream(dir / "plain") << "not a folder";

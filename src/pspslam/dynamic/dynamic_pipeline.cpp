@@ -1,10 +1,13 @@
 #include "pspslam/dynamic/dynamic_pipeline.h"
 
 #include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <span>
 #include <utility>
 
 #include "pspslam/core/clock.h"
+#include "pspslam/core/error.h"
 #include "pspslam/dynamic/keypoint_fusion.h"
 #include "pspslam/geometry/compensated_homography.h"
 #include "pspslam/io/rgbd_sequence.h"
@@ -37,7 +40,7 @@ DynamicPipeline::DynamicPipeline(const DynamicOptions& options, const PinholeCam
   if (options.mode == DynamicMode::exhaustive)
     geometry.search.strategy = SearchStrategy::exhaustive;
   if (uses_geometry(options.mode)) geometry_ = std::make_unique<GeometryStage>(camera, geometry);
-  if (uses_semantics(options.mode)) {
+  if (uses_semantics(options.mode) && options.semantic_masks.empty()) {
     SemanticParams params = options.semantic;
     // Deterministic mode announces one frame ahead: two may be pending and none may be
     // dropped. Real-time mode keeps only the newest pending frame.
@@ -77,7 +80,35 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
   chain_.record(current_id_, H_previous_to_current_);
   previous_gray_ = gray;
   report.flow_ms = milliseconds_since(start);
-  return semantic_ ? semantic_mask(report) : cv::Mat();
+  if (semantic_) return semantic_mask(report);
+  if (uses_semantics(options_.mode) && !options_.semantic_masks.empty())
+    return mask_from_file(frame, report);
+  return {};
+}
+
+cv::Mat DynamicPipeline::mask_from_file(const RgbdFrame& frame, DynamicReport& report) const {
+  const std::filesystem::path file = options_.semantic_masks / per_frame_png_name(frame.name);
+  // Checked first: OpenCV would also print a warning of its own for a missing file.
+  const cv::Mat image = std::filesystem::is_regular_file(file)
+                            ? cv::imread(file.string(), cv::IMREAD_GRAYSCALE)
+                            : cv::Mat();
+  if (image.empty()) {
+    throw Error(file.string() + ": no semantic mask for frame " + frame.name +
+                " (--semantic-masks: an 8-bit PNG per frame, named after its colour image)");
+  }
+  if (image.size() != frame.bgr.size()) {
+    throw Error(file.string() + ": the mask is " + std::to_string(image.cols) + "x" +
+                std::to_string(image.rows) + " but frame " + frame.name + " is " +
+                std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows));
+  }
+  cv::Mat mask = image != 0;
+  if (const int margin = options_.semantic.mask_dilation_px; margin > 0) {
+    cv::dilate(
+        mask, mask,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
+  }
+  report.mask_age_frames = 0;
+  return mask;
 }
 
 void DynamicPipeline::remove_dynamic(const cv::Mat& depth, std::span<const float> keypoint_depths,

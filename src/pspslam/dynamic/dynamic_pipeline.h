@@ -34,6 +34,11 @@ struct DynamicOptions {
   DynamicMode mode = DynamicMode::off;
   // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
   std::filesystem::path model;
+  // Non-empty: the semantic masks are read from this folder instead of running the network
+  // (`run --semantic-masks`): per frame the 8-bit PNG named per_frame_png_name (io/), non-zero =
+  // dynamic, grown by semantic.mask_dilation_px. Masks made elsewhere (a larger segmenter run
+  // offline, a sequence's ground truth, an earlier run's --save-masks) then stand in for step 2.
+  std::filesystem::path semantic_masks;
   // true: never wait for segmentation, use the newest mask warped into the frame (live camera).
   // false: wait for each frame's own mask (reproducible accuracy runs).
   bool realtime = false;
@@ -109,7 +114,8 @@ class DynamicPipeline {
   void announce(const RgbdFrame& frame);
 
   // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
-  // when none is usable).
+  // when none is usable). With DynamicOptions::semantic_masks, the mask is read from there;
+  // throws pspslam::Error naming the file when it is missing or not the frame's size.
   cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report);
 
   // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
@@ -154,6 +160,7 @@ class DynamicPipeline {
     std::chrono::steady_clock::time_point time;
   };
 
+  cv::Mat mask_from_file(const RgbdFrame& frame, DynamicReport& report) const;
   cv::Mat semantic_mask(DynamicReport& report);
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;

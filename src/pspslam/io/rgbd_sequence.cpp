@@ -494,4 +494,8 @@ RgbdFrame RgbdSequence::load(size_t i) const {
   return frame;
 }
 
+std::filesystem::path per_frame_png_name(const std::filesystem::path& rgb_file) {
+  return rgb_file.filename().stem().string() + ".png";
+}
+
 }  // namespace pspslam

@@ -56,7 +56,8 @@ struct RgbdFrame {
   cv::Mat depth;  // CV_32FC1 metres, 0 = no reading (empty for a stereo pair)
   cv::Mat right;  // stereo only: the rectified right image, CV_8UC1 (empty for RGB-D)
   // The colour image's file relative to its sequence ("rgb/1.5.png"); per-frame pictures are
-  // named after it. A live camera frame is named as `pspslam record` would store it.
+  // named after it (per_frame_png_name). A live camera frame is named as `pspslam record` would
+  // store it.
   std::string name;
   // When the frame reached the run from the camera's point of view: a paced sequence's due time
   // (`--realtime`), a live camera's pairing time on the driver thread. Empty for an unpaced
@@ -174,5 +175,10 @@ cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor,
 
 // Reads a colour image (PNG, JPEG, ...) as CV_8UC3 BGR.
 cv::Mat read_color_image(const std::filesystem::path& file);
+
+// The file name of a per-frame picture of the colour image `rgb_file` (RgbdFrame::name):
+// "rgb/1548339828.32144.jpg" -> "1548339828.32144.png". What `--save-masks` and
+// `--save-overlays` write and `--semantic-masks` reads.
+std::filesystem::path per_frame_png_name(const std::filesystem::path& rgb_file);
 
 }  // namespace pspslam

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pspslam/core/error.h"
+#include "pspslam/io/rgbd_sequence.h"
 
 namespace pspslam {
 namespace {
@@ -20,10 +21,6 @@ void write_png(const std::filesystem::path& file, const cv::Mat& image) {
 
 }  // namespace
 
-std::filesystem::path FrameImageWriter::file_name(const std::filesystem::path& rgb_file) {
-  return rgb_file.filename().stem().string() + ".png";
-}
-
 void FrameImageWriter::write_mask(const std::filesystem::path& rgb_file,
                                   const cv::Mat& dynamic_mask, cv::Size size) {
   if (dynamic_mask.empty()) {
@@ -32,13 +29,13 @@ void FrameImageWriter::write_mask(const std::filesystem::path& rgb_file,
   } else {
     cv::compare(dynamic_mask, 0, mask_, cv::CMP_NE);  // any non-zero -> 255
   }
-  write_png(masks_ / file_name(rgb_file), mask_);
+  write_png(masks_ / per_frame_png_name(rgb_file), mask_);
 }
 
 void FrameImageWriter::write_overlay(const std::filesystem::path& rgb_file, const cv::Mat& bgr,
                                      const cv::Mat& labels,
                                      std::span<const KeypointRecord> keypoints) const {
-  write_png(overlays_ / file_name(rgb_file),
+  write_png(overlays_ / per_frame_png_name(rgb_file),
             draw_keypoint_overlay(bgr, labels, classes_, keypoints));
 }
 

@@ -25,9 +25,6 @@ class FrameImageWriter {
   bool writes_masks() const { return !masks_.empty(); }
   bool writes_overlays() const { return !overlays_.empty(); }
 
-  // DIR/<stem of the colour image>.png
-  static std::filesystem::path file_name(const std::filesystem::path& rgb_file);
-
   // The final (fused semantic + geometry) dynamic mask as 8-bit 0/255 of `size`; an empty mask
   // (no dynamic detection, or none yet) is written all 0. Throws pspslam::Error naming the file.
   void write_mask(const std::filesystem::path& rgb_file, const cv::Mat& dynamic_mask,

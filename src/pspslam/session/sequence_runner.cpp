@@ -78,7 +78,10 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
     frames_ = options_.max_frames;
   out_ << input_.source->describe();
   out_ << "dynamic:      " << to_string(dynamic.mode)
-       << (uses_semantics(dynamic.mode) ? " (model " + dynamic.model.string() + ")" : "")
+       << (!uses_semantics(dynamic.mode) ? ""
+           : dynamic.semantic_masks.empty()
+               ? " (model " + dynamic.model.string() + ")"
+               : " (semantic masks from " + dynamic.semantic_masks.string() + ")")
        << (dynamic.realtime ? ", real-time feed" : ", deterministic (waits for each mask)")
        << (limits_.dynamic_note.empty() ? "" : "; " + limits_.dynamic_note) << "\n";
   if (!system.map_file.empty()) {

@@ -4,10 +4,12 @@
 # twin (same seed and motion, --bodies 0), `pspslam run --dynamic full` on both; ATE RMSE (mm) of
 # trajectory.txt and trajectory_refined.txt with the marker body moved onto the camera, then the
 # ratio of each sequence to its twin and how many are within 1.3x.
-# usage: PSPSLAM=build/apps/pspslam WORK=/tmp/kinect_twin [RUN_FLAGS="--model M"] \
+# usage: PSPSLAM=build/apps/pspslam WORK=/tmp/kinect_twin [RUN_FLAGS="--model M"] [TRUE_PEOPLE=1] \
 #        bench/kinect_static_twin.sh
-# (RUN_FLAGS go to every run, twins included; runs already in WORK are reused, so give each
-# variant its own WORK.)
+# (RUN_FLAGS go to every run, twins included; TRUE_PEOPLE=1 gives every run its sequence's own
+# person labels as semantic masks instead of the network's, `--semantic-masks SEQ/mask`: the
+# upper bound of a perfect detector. Runs already in WORK are reused, so give each variant its
+# own WORK.)
 set -euo pipefail
 B=${PSPSLAM:-build/apps/pspslam}
 W=${WORK:-/tmp/kinect_twin}
@@ -25,8 +27,10 @@ for spec in "21 2" "22 3" "23 4" "26 4"; do
       --seed "$seed" --trajectory handheld --sensor kinect --threads 1 >/dev/null
     out=$W/run_${seed}_b$bodies
     # shellcheck disable=SC2086  # RUN_FLAGS is a list of flags
+    masks=()
+    [ "${TRUE_PEOPLE:-0}" = 1 ] && masks=(--semantic-masks "$seq/mask")
     [ -f "$out/stats.json" ] || "$B" -q run --sequence "$seq" --out "$out" --dynamic full \
-      ${RUN_FLAGS:-} >"$W/log_${seed}_b$bodies.txt" 2>&1
+      ${RUN_FLAGS:-} "${masks[@]}" >"$W/log_${seed}_b$bodies.txt" 2>&1
     for f in trajectory.txt trajectory_refined.txt; do
       line="seed $seed bodies $bodies $f $("$B" -q eval --gt "$seq/groundtruth.txt" --est "$out/$f" \
         --gt-body-to-camera "$seq/body_to_camera.txt" --json | "$PY" -c \

@@ -67,12 +67,20 @@ constexpr int kLiveLocalBaKeyframes = 10;
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
 // with a warning that says which model is missing and how to get it; an explicitly requested
-// semantic mode with a missing model is an error.
+// semantic mode with a missing model is an error. With masks from files (`--semantic-masks`) no
+// model is needed, but a mode that uses them is.
 DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::path& model,
-                        bool explicit_model) {
+                        bool explicit_model, bool masks_from_files) {
   const bool automatic = flag_value == "auto";
   const DynamicMode wanted =
       automatic ? DynamicMode::full : parse_dynamic_mode(flag_value, "--dynamic");
+  if (masks_from_files) {
+    if (!uses_semantics(wanted)) {
+      throw Error("--semantic-masks replaces the network's masks, but --dynamic " + flag_value +
+                  " uses none (use semantic, full or exhaustive)");
+    }
+    return wanted;
+  }
   if (!uses_semantics(wanted)) return wanted;
   try {
     load_segmenter_metadata(model);
@@ -201,18 +209,9 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   SystemOptions& system = options.system;
   DynamicOptions& dynamic = system.dynamic;
   dynamic.model = user_or_default(flags.model, data_dir() / "models/pspnet/pspnet.yaml");
-  if (flags.semantic_masks.empty()) {
-    dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty());
-  } else {
-    // The masks stand in for the network: they need a mode with a semantic half (auto: full).
-    dynamic.mode = flags.dynamic == "auto" ? DynamicMode::full
-                                           : parse_dynamic_mode(flags.dynamic, "--dynamic");
-    if (!uses_semantics(dynamic.mode)) {
-      throw Error("--semantic-masks replaces the network's masks, but --dynamic " + flags.dynamic +
-                  " uses none (use semantic, full or exhaustive)");
-    }
-    dynamic.semantic_masks = flags.semantic_masks;
-  }
+  dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty(),
+                             !flags.semantic_masks.empty());
+  dynamic.semantic_masks = flags.semantic_masks;
   system.local_mapping = !flags.no_local_mapping;
   system.synchronous_local_mapping = !flags.realtime;
   const bool live = flags.realtime || !flags.camera.empty();

@@ -2,7 +2,6 @@
 
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <span>
 #include <utility>
 
@@ -101,14 +100,8 @@ cv::Mat DynamicPipeline::mask_from_file(const RgbdFrame& frame, DynamicReport& r
                 std::to_string(image.rows) + " but frame " + frame.name + " is " +
                 std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows));
   }
-  cv::Mat mask = image != 0;
-  if (const int margin = options_.semantic.mask_dilation_px; margin > 0) {
-    cv::dilate(
-        mask, mask,
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
-  }
   report.mask_age_frames = 0;
-  return mask;
+  return dilate_mask(image != 0, options_.semantic.mask_dilation_px);
 }
 
 void DynamicPipeline::remove_dynamic(const cv::Mat& depth, std::span<const float> keypoint_depths,

@@ -239,6 +239,59 @@ TEST(Config, MonocularCameraRoundTripsAndRefusesDepthAndBaselineKeys) {
                                   "camera (camera.type is monocular)");
 }
 
+// The geometry stage's parameters (paper III.B/C) come from the config's `geometry:` section.
+TEST(Config, GeometrySectionSetsTheStageAndRoundTrips) {
+  const auto dir = testing::make_temp_dir("config");
+  const SystemConfig config = load_config(
+      write_file(dir, std::string(kValidCamera) +
+                          "geometry:\n  region:\n    max_grow_radius_m: 1.25\n  search:\n"
+                          "    band_width_px: 60\n  multiview:\n    disagreement: either_sign\n"));
+  GeometryParams expected;
+  expected.region.max_grow_radius_m = 1.25f;
+  expected.search.band_width_px = 60.0f;
+  expected.multiview.disagreement = DepthDisagreement::either_sign;
+  EXPECT_TRUE(config.geometry == expected);
+  EXPECT_TRUE(load_config(write_file(dir, kValidCamera)).geometry == GeometryParams{});
+
+  SystemConfig changed = config;
+  changed.geometry.homography.inlier_threshold_px = 1.7;
+  changed.geometry.region.static_barrier_radius_px = 3.3f;
+  changed.geometry.references.older_view_gain_share = 0.35;
+  changed.geometry.previous_mask_prior = false;
+  save_config(dir / "saved.yaml", changed);
+  EXPECT_TRUE(load_config(dir / "saved.yaml").geometry == changed.geometry);
+  // The defaults are not written, so configs written here load in builds without the section.
+  SystemConfig plain = config;
+  plain.geometry = GeometryParams{};
+  save_config(dir / "plain.yaml", plain);
+  std::ifstream saved(dir / "plain.yaml");
+  const std::string text((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("geometry"), std::string::npos) << text;
+}
+
+TEST(Config, GeometryErrorsNameFileLineAndKey) {
+  const auto dir = testing::make_temp_dir("config");
+  const auto strategy = write_file(
+      dir, std::string(kValidCamera) + "geometry:\n  search:\n    strategy: exhaustive\n");
+  EXPECT_EQ(load_error(strategy),
+            strategy.string() +
+                ":15: key 'geometry.search.strategy' is not a config key: pspslam run --dynamic "
+                "chooses the search (full: ant_colony, exhaustive: every point)");
+  const auto band =
+      write_file(dir, std::string(kValidCamera) + "geometry:\n  search:\n    band_width_px: 0\n");
+  EXPECT_EQ(load_error(band),
+            band.string() + ":15: key 'geometry.search.band_width_px' must be > 0");
+  const auto typo =
+      write_file(dir, std::string(kValidCamera) + "geometry:\n  region:\n    max_grow_radius: 1\n");
+  EXPECT_EQ(load_error(typo), typo.string() +
+                                  ":15: unknown key 'geometry.region.max_grow_radius' (did you "
+                                  "mean 'geometry.region.max_grow_radius_m'?)");
+  const auto section = write_file(dir, std::string(kValidCamera) + "geometry:\n  regions: {}\n");
+  EXPECT_EQ(load_error(section), section.string() +
+                                     ":14: unknown key 'geometry.regions' (did you mean "
+                                     "'geometry.region'?)");
+}
+
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
   const auto dir = testing::make_temp_dir("config");
   const auto file = write_file(dir, replace(kValidCamera, "  fx: 500.5\n", "  fxx: 500.5\n"));

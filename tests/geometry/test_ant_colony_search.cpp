@@ -2,8 +2,8 @@
 
 #include <random>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/ant_colony_search.h"
 #include "pspslam/geometry/convex_hull.h"
 
@@ -234,7 +234,7 @@ TEST(AntColonySearch, ParamsFromYaml) {
     FAIL() << "expected Error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(),
-                 "c.yaml: key 'geometry.search.strategy' must be ant_colony or exhaustive, not "
+                 "c.yaml:1: key 'geometry.search.strategy' must be ant_colony or exhaustive, not "
                  "'random'");
   }
   const YAML::Node zero = YAML::Load("band_width_px: 0\n");

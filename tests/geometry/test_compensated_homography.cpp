@@ -3,8 +3,8 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/compensated_homography.h"
 
 namespace pspslam {
@@ -159,7 +159,7 @@ TEST(CompensatedHomography, ParamsFromYamlNameTheKey) {
     FAIL() << "expected Error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(),
-                 "geometry.yaml: key 'geometry.homography.inlier_threshold_px' must be > 0");
+                 "geometry.yaml:1: key 'geometry.homography.inlier_threshold_px' must be > 0");
   }
   const YAML::Node typo = YAML::Load("inlier_treshold_px: 2\n");
   YamlSection typo_section(typo, "geometry.yaml", "geometry.homography");

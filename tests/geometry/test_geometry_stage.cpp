@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/geometry_stage.h"
 #include "pspslam/geometry/test_scene.h"
 

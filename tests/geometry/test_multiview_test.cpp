@@ -2,8 +2,8 @@
 
 #include <random>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/multiview_test.h"
 
 namespace pspslam {
@@ -192,7 +192,7 @@ TEST(MultiViewTest, ParamsFromYamlNameTheKey) {
     FAIL() << "expected Error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(),
-                 "g.yaml: key 'geometry.multiview.min_dynamic_vote_fraction' must be in (0, 1]");
+                 "g.yaml:1: key 'geometry.multiview.min_dynamic_vote_fraction' must be in (0, 1]");
   }
   const YAML::Node wrong_type = YAML::Load("max_parallax_deg: wide\n");
   YamlSection type_section(wrong_type, "g.yaml", "geometry.multiview");

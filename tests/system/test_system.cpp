@@ -326,5 +326,32 @@ TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSeque
       << "two deterministic runs of the same sequence gave different trajectories";
 }
 
+// The config's `geometry:` section reaches the geometry stage of a run: with the multi-view test
+// limited to depths of 7.9-8 m (the synthetic room is smaller) nothing is found dynamic, while
+// the sequence's own config finds the people.
+TEST(RunCommand, GeometryConfigSectionReachesTheStage) {
+  const std::filesystem::path dir = testing::make_temp_dir("run_geometry_config");
+  SynthOptions options = static_room(60);
+  options.bodies = 3;
+  options.threads = 0;
+  write_sequence(options, dir / "sequence");
+  std::ofstream(dir / "far_only.yaml")
+      << read_text(dir / "sequence" / "config.yaml")
+      << "geometry:\n  multiview:\n    min_depth_m: 7.9\n    max_depth_m: 8.0\n";
+  const auto dynamic_points = [&](const std::string& extra, const std::string& out) {
+    std::string output;
+    const int status = testing::run_shell(
+        std::string(PSPSLAM_CLI_PATH) + " run --sequence " + (dir / "sequence").string() +
+            " --dynamic geometry --loop-closing off --out " + (dir / out).string() + extra,
+        &output);
+    EXPECT_EQ(status, 0) << output;
+    const std::string stats = read_text(dir / out / "stats.json");
+    const size_t at = stats.find("\"dynamic_points\": ");
+    return at == std::string::npos ? -1L : std::stol(stats.substr(at + 18));
+  };
+  EXPECT_GT(dynamic_points("", "default"), 100);
+  EXPECT_EQ(dynamic_points(" --config " + (dir / "far_only.yaml").string(), "far_only"), 0);
+}
+
 }  // namespace
 }  // namespace pspslam

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <vector>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 namespace {
@@ -150,6 +150,75 @@ OrbConfig read_orb(YamlSection section) {
   return orb;
 }
 
+GeometryParams read_geometry(YamlSection section) {
+  YamlSection search = section.section("search");
+  if (search.contains("strategy")) {
+    throw Error(search.where("strategy") + "key '" + search.qualified("strategy") +
+                "' is not a config key: pspslam run --dynamic chooses the search (full: "
+                "ant_colony, exhaustive: every point)");
+  }
+  return GeometryParams::from_yaml(section);
+}
+
+// Every key of the geometry stage but the search strategy (chosen by --dynamic).
+void write_geometry(YAML::Emitter& out, const GeometryParams& g) {
+  const auto key = [&out](const char* name) -> YAML::Emitter& {
+    return out << YAML::Key << name << YAML::Value;
+  };
+  key("geometry") << YAML::BeginMap;
+  key("homography") << YAML::BeginMap;
+  key("inlier_threshold_px") << g.homography.inlier_threshold_px;
+  key("max_ransac_iterations") << g.homography.max_ransac_iterations;
+  key("ransac_confidence") << g.homography.ransac_confidence;
+  key("lm_max_iterations") << g.homography.lm_max_iterations;
+  key("random_seed") << g.homography.random_seed;
+  out << YAML::EndMap;
+  const MultiViewParams& m = g.multiview;
+  key("multiview") << YAML::BeginMap;
+  key("depth_threshold_abs_m") << m.depth_threshold_abs_m;
+  key("depth_threshold_relative") << m.depth_threshold_relative;
+  key("disagreement") << (m.disagreement == DepthDisagreement::farther_only ? "farther_only"
+                                                                            : "either_sign");
+  key("max_parallax_deg") << m.max_parallax_deg;
+  key("reference_patch_radius") << m.reference_patch_radius;
+  key("min_dynamic_vote_fraction") << m.min_dynamic_vote_fraction;
+  key("max_reference_views") << m.max_reference_views;
+  key("min_depth_m") << m.min_depth_m;
+  key("max_depth_m") << m.max_depth_m;
+  out << YAML::EndMap;
+  const AntColonyParams& a = g.search;
+  key("search") << YAML::BeginMap;
+  key("search_radius_px") << a.search_radius_px;
+  key("band_width_px") << a.band_width_px;
+  key("node_spacing_px") << a.node_spacing_px;
+  key("lane_spacing_px") << a.lane_spacing_px;
+  key("alternate_lanes") << a.alternate_lanes;
+  key("max_band_rounds") << a.max_band_rounds;
+  out << YAML::EndMap;
+  const RegionGrowParams& r = g.region;
+  key("region") << YAML::BeginMap;
+  key("enabled") << r.enabled;
+  key("stride") << r.stride;
+  key("max_step_abs_m") << r.max_step_abs_m;
+  key("max_step_relative") << r.max_step_relative;
+  key("max_depth_from_seed_m") << r.max_depth_from_seed_m;
+  key("max_grow_radius_px") << r.max_grow_radius_px;
+  key("max_grow_radius_m") << r.max_grow_radius_m;
+  key("min_seeds_per_region") << r.min_seeds_per_region;
+  key("max_region_samples") << r.max_region_samples;
+  key("static_barrier_radius_px") << r.static_barrier_radius_px;
+  key("dilation_px") << r.dilation_px;
+  out << YAML::EndMap;
+  key("references") << YAML::BeginMap;
+  key("wanted_coverage") << g.references.wanted_coverage;
+  key("point_stride") << g.references.point_stride;
+  key("older_view_gain_share") << g.references.older_view_gain_share;
+  out << YAML::EndMap;
+  key("previous_mask_prior") << g.previous_mask_prior;
+  key("output_warped_previous_mask") << g.output_warped_previous_mask;
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 SensorType parse_sensor_type(const std::string& name, const std::string& where) {
@@ -184,6 +253,7 @@ SystemConfig load_config(const std::filesystem::path& file) {
   SystemConfig config;
   config.camera = read_camera(top.section("camera"));
   config.orb = read_orb(top.section("orb"));
+  config.geometry = read_geometry(top.section("geometry"));
   top.finish();
   return config;
 }
@@ -191,6 +261,7 @@ SystemConfig load_config(const std::filesystem::path& file) {
 void save_config(const std::filesystem::path& file, const SystemConfig& config) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
+  out.SetFloatPrecision(9);  // the geometry stage's float keys read back to the same value
   out << YAML::BeginMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   const PinholeCamera& p = config.camera.pinhole;
@@ -240,6 +311,8 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   // builds that predate the key (the accuracy panel runs both on the same sequences).
   if (config.orb.mask_compensation) out << YAML::Key << "mask_compensation" << YAML::Value << true;
   out << YAML::EndMap;
+  // Likewise only when it differs from the defaults.
+  if (config.geometry != GeometryParams{}) write_geometry(out, config.geometry);
   out << YAML::EndMap;
   std::ofstream stream(file);
   if (!stream) throw Error(file.string() + ": cannot write config file");

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/geometry/geometry_stage.h"
 
 namespace pspslam {
 
@@ -71,6 +72,11 @@ struct OrbConfig {
 struct SystemConfig {
   CameraConfig camera;
   OrbConfig orb;
+  // The OC multi-view geometry stage (paper III.B/C; YAML section `geometry:` with the
+  // sub-sections homography, multiview, search, region, references, every key optional). Which
+  // search runs is not a key: `pspslam run --dynamic` chooses it (full: the reverse ant colony,
+  // exhaustive: every point), so `geometry.search.strategy` is refused.
+  GeometryParams geometry;
 };
 
 // Loads a config file. Any missing required key, unknown key or invalid value raises

@@ -44,7 +44,9 @@ struct DynamicOptions {
   bool realtime = false;
   // mask_dilation_px is the semantic margin; queue_size is set by the pipeline from `realtime`.
   SemanticParams semantic;
-  GeometryParams geometry;  // search.strategy is set from the mode (full vs exhaustive)
+  // The config's `geometry:` section (System copies it here); search.strategy is set from the
+  // mode (full: ant colony, exhaustive: every point).
+  GeometryParams geometry;
   DynamicCullingParams culling;
   // Segment every n-th frame (1: all); the others use the newest mask warped by the frames'
   // homographies. Frees the network's core for local mapping in real-time runs.

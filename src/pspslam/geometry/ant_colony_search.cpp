@@ -3,15 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/convex_hull.h"
 
 namespace pspslam {
 namespace {
 
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
 }
 
 }  // namespace
@@ -24,7 +24,7 @@ AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
   } else if (strategy == "exhaustive") {
     p.strategy = SearchStrategy::exhaustive;
   } else {
-    throw Error(section.file() + ": key '" + section.qualified("strategy") + "' must be " +
+    throw Error(section.where("strategy") + "key '" + section.qualified("strategy") + "' must be " +
                 "ant_colony or exhaustive, not '" + strategy + "'");
   }
   p.search_radius_px = section.optional("search_radius_px", p.search_radius_px);

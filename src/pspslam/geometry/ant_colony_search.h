@@ -37,6 +37,7 @@ struct AntColonyParams {
 
   // Reads the optional keys of a `search:` section (strategy: ant_colony | exhaustive).
   static AntColonyParams from_yaml(YamlSection& section);
+  bool operator==(const AntColonyParams&) const = default;
 };
 
 struct SearchResult {

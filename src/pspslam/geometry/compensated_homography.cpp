@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 namespace {
@@ -19,7 +19,7 @@ using Vector8d = Eigen::Matrix<double, 8, 1>;
 using Matrix8d = Eigen::Matrix<double, 8, 8>;
 
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
 }
 
 // Hartley normalisation: centroid to the origin, mean distance sqrt(2). Without it the DLT and

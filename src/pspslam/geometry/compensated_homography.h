@@ -24,6 +24,7 @@ struct HomographyParams {
   // Reads the optional keys of a `homography:` section; unknown keys and out-of-range values
   // raise pspslam::Error naming the key.
   static HomographyParams from_yaml(YamlSection& section);
+  bool operator==(const HomographyParams&) const = default;
 };
 
 struct CompensatedHomography {

@@ -7,9 +7,9 @@
 #include <functional>
 #include <opencv2/imgproc.hpp>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 namespace {
@@ -47,17 +47,17 @@ GeometryParams GeometryParams::from_yaml(YamlSection& section) {
   p.references.wanted_coverage =
       references.optional("wanted_coverage", p.references.wanted_coverage);
   if (p.references.wanted_coverage < 1)
-    throw Error(references.file() + ": key '" + references.qualified("wanted_coverage") +
-                "' must be >= 1");
+    throw Error(references.where("wanted_coverage") + "key '" +
+                references.qualified("wanted_coverage") + "' must be >= 1");
   p.references.point_stride = references.optional("point_stride", p.references.point_stride);
   if (p.references.point_stride < 1)
-    throw Error(references.file() + ": key '" + references.qualified("point_stride") +
+    throw Error(references.where("point_stride") + "key '" + references.qualified("point_stride") +
                 "' must be >= 1");
   p.references.older_view_gain_share =
       references.optional("older_view_gain_share", p.references.older_view_gain_share);
   if (!(p.references.older_view_gain_share > 0.0 && p.references.older_view_gain_share <= 1.0))
-    throw Error(references.file() + ": key '" + references.qualified("older_view_gain_share") +
-                "' must be in (0, 1]");
+    throw Error(references.where("older_view_gain_share") + "key '" +
+                references.qualified("older_view_gain_share") + "' must be in (0, 1]");
   references.finish();
   p.previous_mask_prior = section.optional("previous_mask_prior", p.previous_mask_prior);
   p.output_warped_previous_mask =

@@ -32,6 +32,7 @@ struct GeometryParams {
     int wanted_coverage = 2;  // a candidate counts as covered once this many picks see it
     int point_stride = 8;     // coverage is estimated on every point_stride-th candidate
     double older_view_gain_share = 1.0;  // see ReferenceSelector::Params
+    bool operator==(const ReferenceChoice&) const = default;
   } references;
   // Test the points inside the previous frame's dynamic mask (warped into this frame by the
   // compensated homography) before walking the path.
@@ -41,6 +42,7 @@ struct GeometryParams {
   bool output_warped_previous_mask = false;
 
   static GeometryParams from_yaml(YamlSection& section);
+  bool operator==(const GeometryParams&) const = default;
 };
 
 // One frame's input. Spans and cv::Mat headers refer to caller-owned data for the duration of

@@ -4,14 +4,14 @@
 #include <cmath>
 #include <limits>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 namespace {
 
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
 }
 
 }  // namespace
@@ -31,7 +31,7 @@ MultiViewParams MultiViewParams::from_yaml(YamlSection& section) {
   } else if (disagreement == "either_sign") {
     p.disagreement = DepthDisagreement::either_sign;
   } else {
-    throw Error(section.file() + ": key '" + section.qualified("disagreement") +
+    throw Error(section.where("disagreement") + "key '" + section.qualified("disagreement") +
                 "' must be farther_only or either_sign, not '" + disagreement + "'");
   }
   p.max_parallax_deg = section.optional("max_parallax_deg", p.max_parallax_deg);

@@ -43,6 +43,7 @@ struct MultiViewParams {
   double max_depth_m = 8.0;
 
   static MultiViewParams from_yaml(YamlSection& section);
+  bool operator==(const MultiViewParams&) const = default;
 };
 
 // A reference view: keyframe pose and its depth image (CV_32FC1 metres, 0 = no reading).

@@ -5,14 +5,14 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 namespace {
 
 void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.file() + ": key '" + section.qualified(key) + "' " + what);
+  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
 }
 
 }  // namespace

@@ -44,6 +44,7 @@ struct RegionGrowParams {
   int dilation_px = 0;
 
   static RegionGrowParams from_yaml(YamlSection& section);
+  bool operator==(const RegionGrowParams&) const = default;
 };
 
 // Reusable grower (buffers kept between frames). Not thread-safe; one per worker thread.

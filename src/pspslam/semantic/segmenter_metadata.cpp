@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <system_error>
 
-#include "pspslam/config/yaml_section.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
+#include "pspslam/core/yaml_section.h"
 #include "pspslam/semantic/segmenter.h"
 
 namespace pspslam {

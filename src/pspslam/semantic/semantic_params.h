@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
 

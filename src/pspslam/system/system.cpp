@@ -252,6 +252,7 @@ System::System(const SystemConfig& config, SystemOptions options)
   }
   if (options.dynamic.mode != DynamicMode::off) {
     options.dynamic.semantic.thread_nice = options.background_thread_nice;
+    options.dynamic.geometry = config.geometry;
     dynamic_ = std::make_unique<DynamicPipeline>(options.dynamic, config.camera.pinhole, *map_);
     if (options.localization_only) dynamic_->use_loaded_map_only();
   }

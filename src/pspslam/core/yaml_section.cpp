@@ -1,4 +1,4 @@
-#include "pspslam/config/yaml_section.h"
+#include "pspslam/core/yaml_section.h"
 
 #include <vector>
 

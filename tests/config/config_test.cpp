@@ -286,6 +286,9 @@ TEST(Config, GeometryErrorsNameFileLineAndKey) {
   EXPECT_EQ(load_error(typo), typo.string() +
                                   ":15: unknown key 'geometry.region.max_grow_radius' (did you "
                                   "mean 'geometry.region.max_grow_radius_m'?)");
+  const auto scalar = write_file(dir, std::string(kValidCamera) + "geometry:\n  region: 5\n");
+  EXPECT_EQ(load_error(scalar),
+            scalar.string() + ":14: 'geometry.region' must be a mapping of key: value");
   const auto section = write_file(dir, std::string(kValidCamera) + "geometry:\n  regions: {}\n");
   EXPECT_EQ(load_error(section), section.string() +
                                      ":14: unknown key 'geometry.regions' (did you mean "

@@ -9,7 +9,10 @@ namespace pspslam {
 YamlSection::YamlSection(const YAML::Node& node, std::string file, std::string path)
     : node_(node), file_(std::move(file)), path_(std::move(path)) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {
-    throw Error(file_ + ": '" + (path_.empty() ? std::string("<root>") : path_) +
+    const YAML::Mark mark = node_.Mark();
+    std::string where = file_;
+    if (!mark.is_null()) where.append(":").append(std::to_string(mark.line + 1));
+    throw Error(where + ": '" + (path_.empty() ? std::string("<root>") : path_) +
                 "' must be a mapping of key: value");
   }
 }

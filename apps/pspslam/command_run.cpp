@@ -308,8 +308,8 @@ Command add_run_command(CLI::App& root) {
       "run SLAM on an RGB-D sequence and write the trajectory.\n"
       "Reads a sequence in TUM layout (rgb.txt, depth.txt or associations.txt, optional "
       "groundtruth.txt)\nand writes OUT/trajectory.txt (every tracked frame), "
-      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv and "
-      "OUT/stats.json. With ground truth, prints ATE.");
+      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv, "
+      "OUT/stats.json and OUT/run_config.yaml (the config used). With ground truth, prints ATE.");
   auto flags = std::make_shared<RunFlags>();
   CLI::Option* sequence = app->add_option("--sequence", flags->sequence, "sequence folder");
   CLI::Option* camera = app->add_option("--camera", flags->camera,

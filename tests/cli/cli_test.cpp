@@ -371,6 +371,37 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
   }
 }
 
+// Every run writes the config it used: OUT/run_config.yaml repeats the run exactly (here with a
+// geometry: section and a --sensor override, which it carries), and stats.json names the config
+// file and the binary's version.
+TEST(CliRun, RunConfigRepeatsTheRun) {
+  const auto dir = testing::make_temp_dir("cli_run_config");
+  ASSERT_EQ(
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 30 --bodies 1 --seed 3").status,
+      0);
+  std::ofstream(dir / "tuned.yaml")
+      << read_text(dir / "seq" / "config.yaml") << "geometry:\n  search:\n    band_width_px: 60\n";
+  const Result first =
+      pspslam("run --sequence " + (dir / "seq").string() + " --config " +
+              (dir / "tuned.yaml").string() + " --dynamic geometry --out " + (dir / "a").string());
+  ASSERT_EQ(first.status, 0) << first.output;
+  const std::string used = read_text(dir / "a" / "run_config.yaml");
+  EXPECT_TRUE(contains(used, "band_width_px: 60")) << used;
+  const Result again = pspslam("run --sequence " + (dir / "seq").string() + " --config " +
+                               (dir / "a" / "run_config.yaml").string() +
+                               " --dynamic geometry --out " + (dir / "b").string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(read_text(dir / "a" / "trajectory.txt"), read_text(dir / "b" / "trajectory.txt"));
+  const nlohmann::json stats = nlohmann::json::parse(read_text(dir / "a" / "stats.json"));
+  EXPECT_EQ(stats["config"], (dir / "tuned.yaml").string());
+  EXPECT_EQ(stats["version"].get<std::string>().rfind("pspslam 0.1.0 (git ", 0), 0u) << stats;
+
+  const Result mono = pspslam("run --sequence " + (dir / "seq").string() +
+                              " --sensor monocular --dynamic off --out " + (dir / "m").string());
+  ASSERT_EQ(mono.status, 0) << mono.output;
+  EXPECT_TRUE(contains(read_text(dir / "m" / "run_config.yaml"), "type: monocular"));
+}
+
 // --motion-prior reaches the pose-only optimisation: a prior of 1 mm / 0.05° makes the online
 // positions follow the constant-velocity prediction, so their second differences (frame-to-frame
 // changes of the velocity) shrink; σ ≤ 0 is an error.

@@ -1,5 +1,7 @@
 #include "pspslam/core/version.h"
 
+#include "git_revision.h"  // generated at build time (cmake/git_revision.cmake)
+
 namespace pspslam {
 
 std::string version_string() {

@@ -10,6 +10,7 @@
 
 #include "pspslam/core/error.h"
 #include "pspslam/core/thread_priority.h"
+#include "pspslam/core/version.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/eval/stats.h"
 #include "pspslam/session/frame_log.h"
@@ -249,6 +250,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
 
   const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
   nlohmann::ordered_json json = {{"sequence", input.source.name()},
+                                 {"version", version_string()},
+                                 {"config", input.config_file.string()},
                                  {"sensor", to_string(input.sensor)},
                                  {"mode", to_string(system.dynamic.mode)},
                                  {"realtime", system.dynamic.realtime},

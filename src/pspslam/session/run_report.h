@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <optional>
 #include <ostream>
 
@@ -26,6 +27,7 @@ struct RunReportInput {
   double seconds = 0.0;
   bool interrupted = false;
   SensorType sensor = SensorType::rgbd;
+  std::filesystem::path config_file;  // the config the run read (stats.json "config")
   // What the sensor could not run (system/frame_builder.h apply_sensor_limits): the mode asked
   // for, and the note of the summary.
   DynamicMode requested_mode = DynamicMode::off;

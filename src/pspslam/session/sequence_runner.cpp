@@ -100,6 +100,9 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
       images_.set_classes({model.classes, class_ids(model.classes, names, model.file.string())});
     }
   }
+  // The config as the run uses it (a --sensor override applied; the original's comments are not
+  // kept): `pspslam run --config OUT/run_config.yaml` repeats the run.
+  save_config(options_.outputs.folder / "run_config.yaml", input_.config);
   system_ = std::make_unique<System>(input_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(input_.config.camera.pinhole);
@@ -273,6 +276,7 @@ void SequenceRunner::finish(double seconds) {
                     .seconds = seconds,
                     .interrupted = interrupted(),
                     .sensor = input_.config.camera.type,
+                    .config_file = input_.config_file,
                     .requested_mode = limits_.requested_mode,
                     .dynamic_note = limits_.dynamic_note},
                    out_);

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "pspslam/eval/ate.h"
 #include "pspslam/io/rgbd_sequence.h"
@@ -99,6 +100,42 @@ TEST(Stereo, GeometryMaskStaysOnThePeople) {
   EXPECT_GT(precision, 0.9) << "recall " << recall;
   EXPECT_GT(recall, 0.3) << "precision " << precision;  // and it still finds them
   std::printf("stereo geometry mask, 120 frames: precision %.3f, recall %.3f\n", precision, recall);
+}
+
+// A deterministic run announces each frame before the one before it is processed, and the
+// stereo builder starts the frame's right-image extraction and block matching then. The poses
+// must be those of frames extracted on their own: here every frame announced ahead but every
+// fifth (those start inline), and one more frame announced at the end that is never processed.
+TEST(Stereo, FramesPreparedAheadGiveTheSameTrajectory) {
+  const SyntheticScene scene(stereo_room(41, 2));  // the 41st is announced, never processed
+  std::vector<RgbdFrame> frames;
+  SynthFrame rendered;
+  for (size_t i = 0; i < scene.frame_count(); ++i) {
+    frames.push_back(stereo_frame(scene, i, rendered));
+    frames.back().bgr = frames.back().bgr.clone();  // `rendered` is drawn over for the next
+  }
+  const auto run = [&](bool ahead) {
+    SystemOptions options;
+    options.place.loop_closing = false;
+    options.synchronous_local_mapping = true;
+    options.dynamic.mode = DynamicMode::geometry;  // the dense depth is used too
+    System system(scene.system_config(), options);
+    std::vector<Pose> poses;
+    for (size_t i = 0; i + 1 < frames.size(); ++i) {
+      if (ahead && i == 0) system.announce(frames[0]);
+      if (ahead && (i + 1) % 5 != 0) system.announce(frames[i + 1]);
+      const FrameReport report = system.process(frames[i]);
+      EXPECT_TRUE(report.tracking.T_world_camera.has_value()) << "frame " << i;
+      poses.push_back(report.tracking.T_world_camera.value_or(Pose::Identity()));
+    }
+    system.shutdown();
+    return poses;
+  };
+  const std::vector<Pose> inline_poses = run(false), ahead_poses = run(true);
+  ASSERT_EQ(inline_poses.size(), ahead_poses.size());
+  for (size_t i = 0; i < inline_poses.size(); ++i) {
+    EXPECT_TRUE(inline_poses[i].matrix() == ahead_poses[i].matrix()) << "frame " << i;
+  }
 }
 
 TEST(Stereo, AFrameWithoutItsRightImageIsAnErrorNamingIt) {

@@ -1,7 +1,9 @@
 #include "pspslam/system/frame_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <future>
+#include <memory>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -76,7 +78,6 @@ class StereoFrameBuilder final : public FrameBuilder {
   StereoFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
                      std::shared_ptr<const ScalePyramid> pyramid, bool dense_depth)
       : left_extractor_(orb),
-        right_extractor_(right_config(orb)),
         camera_(std::move(camera)),
         pyramid_(std::move(pyramid)),
         dense_depth_(dense_depth) {
@@ -90,42 +91,45 @@ class StereoFrameBuilder final : public FrameBuilder {
     const double max_disparity = 0.5 * camera_->bf / matching_.min_depth_m;
     const int disparities =
         std::clamp(static_cast<int>(std::ceil(max_disparity / 16.0)) * 16, 16, 96);
-    block_matcher_ = cv::StereoBM::create(disparities, 11);
+    for (auto& work : images_) work = std::make_unique<ImageWork>(right_config(orb), disparities);
+    block_matcher_for_calls_ = cv::StereoBM::create(disparities, 11);
+  }
+
+  // The right image's features and the dense depth need only the frame's two images, not the
+  // mask or the map: a deterministic run starts them when the frame is announced, one frame
+  // ahead, so they run while the frame before is tracked and its keyframe refined (time in
+  // which the caller thread only waits) instead of on the frame's own path.
+  void prepare(const RgbdFrame& frame) override {
+    if (frame.right.empty() || frame.right.size() != left_size(frame)) return;  // extract() says
+    ImageWork& work = *images_[next_work_];
+    next_work_ = 1 - next_work_;
+    start(work, frame);
   }
 
   void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
                OrbFeatures& features) override {
-    if (frame.right.empty()) {
-      throw Error("stereo camera: frame " + frame.name + " has no right image");
+    check_pair(frame);
+    current_ = find(frame);
+    if (current_ == nullptr) {  // not announced (live runs): start it now, beside the left image
+      current_ = images_[next_work_].get();
+      next_work_ = 1 - next_work_;
+      start(*current_, frame, gray);
     }
-    if (frame.right.size() != gray.size()) {
-      throw Error("stereo camera: the right image of " + frame.name + " is " +
-                  std::to_string(frame.right.cols) + "x" + std::to_string(frame.right.rows) +
-                  " but the left is " + std::to_string(gray.cols) + "x" +
-                  std::to_string(gray.rows));
-    }
-    left_gray_ = gray;
-    // The dense depth needs only the two images: it runs beside both extractions.
-    if (dense_depth_) {
-      dense_ = std::async(std::launch::async, [this, left = gray, right = frame.right] {
-        return dense_depth(left, right);
-      });
-    }
-    auto right = std::async(std::launch::async, [&] {
-      right_extractor_.extract(frame.right, cv::Mat(), right_features_);
-    });
     left_extractor_.extract(gray, mask, features);
-    right.get();
+    current_->right_done.get();
     // Matched once, before dynamic removal, so the geometry stage can use the depths too.
-    match_stereo(features.keypoints, features.descriptors, right_features_.keypoints,
-                 right_features_.descriptors, gray, frame.right, *pyramid_, camera_->bf, matching_,
+    match_stereo(features.keypoints, features.descriptors, current_->right.keypoints,
+                 current_->right.descriptors, gray, frame.right, *pyramid_, camera_->bf, matching_,
                  depths_);
     extracted_ = features.keypoints;
   }
 
   cv::Mat depth_image(const RgbdFrame& frame) override {
-    if (dense_.valid()) return dense_.get();
-    return dense_depth(left_gray_, frame.right);
+    if (current_ != nullptr && current_->dense_done.valid() && current_->index == frame.index)
+      return current_->dense_done.get();
+    cv::Mat gray = frame.gray;
+    if (gray.empty()) cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    return dense_depth(block_matcher_for_calls_, gray, frame.right);
   }
 
   std::span<const float> keypoint_depths() const override { return depths_.depth; }
@@ -154,22 +158,82 @@ class StereoFrameBuilder final : public FrameBuilder {
   }
 
  private:
+  // One frame's image-only work (see prepare()). Two, used in turn: the next frame's runs while
+  // the current frame's results are read. Each has its own extractor and block matcher, which
+  // keep scratch buffers and so serve one thread at a time.
+  struct ImageWork {
+    ImageWork(const OrbConfig& orb, int disparities)
+        : extractor(orb), block_matcher(cv::StereoBM::create(disparities, 11)) {}
+    size_t index = 0;
+    Timestamp timestamp = 0.0;
+    OrbExtractor extractor;
+    cv::Ptr<cv::StereoBM> block_matcher;
+    OrbFeatures right;
+    std::future<void> right_done;
+    std::future<cv::Mat> dense_done;  // invalid when no dense depth is wanted
+  };
+
+  static cv::Size left_size(const RgbdFrame& frame) {
+    return frame.gray.empty() ? frame.bgr.size() : frame.gray.size();
+  }
+
+  static void check_pair(const RgbdFrame& frame) {
+    if (frame.right.empty()) {
+      throw Error("stereo camera: frame " + frame.name + " has no right image");
+    }
+    const cv::Size left = left_size(frame);
+    if (frame.right.size() != left) {
+      throw Error("stereo camera: the right image of " + frame.name + " is " +
+                  std::to_string(frame.right.cols) + "x" + std::to_string(frame.right.rows) +
+                  " but the left is " + std::to_string(left.width) + "x" +
+                  std::to_string(left.height));
+    }
+  }
+
+  // `gray`: the left image in grey when the caller has it; otherwise the task converts it.
+  void start(ImageWork& work, const RgbdFrame& frame, cv::Mat gray = cv::Mat()) {
+    if (gray.empty()) gray = frame.gray;
+    // The slot's previous frame may have been announced and never processed (end of the run).
+    if (work.right_done.valid()) work.right_done.wait();
+    if (work.dense_done.valid()) work.dense_done.wait();
+    work.index = frame.index;
+    work.timestamp = frame.timestamp;
+    work.right_done = std::async(std::launch::async, [&work, right = frame.right] {
+      work.extractor.extract(right, cv::Mat(), work.right);
+    });
+    if (dense_depth_) {
+      work.dense_done =
+          std::async(std::launch::async, [this, &work, gray, bgr = frame.bgr, right = frame.right] {
+            cv::Mat left = gray;
+            if (left.empty()) cv::cvtColor(bgr, left, cv::COLOR_BGR2GRAY);
+            return dense_depth(work.block_matcher, left, right);
+          });
+    }
+  }
+
+  ImageWork* find(const RgbdFrame& frame) {
+    for (const auto& work : images_) {
+      if (work->right_done.valid() && work->index == frame.index &&
+          work->timestamp == frame.timestamp)
+        return work.get();
+    }
+    return nullptr;
+  }
+
   OrbExtractor left_extractor_;
-  OrbExtractor right_extractor_;  // one per thread: an extractor keeps scratch buffers
-  OrbFeatures right_features_;
   StereoDepths depths_;                  // per extracted left keypoint
   std::vector<cv::KeyPoint> extracted_;  // the left keypoints depths_ belongs to
-  cv::Mat left_gray_;                    // of the frame being built (shared, not copied)
   std::shared_ptr<const RgbdCamera> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   // CV_32F metres at full resolution from block matching at half resolution (nearest-neighbour
   // upsampling: interpolating across a depth edge would invent depths between the two surfaces).
-  cv::Mat dense_depth(const cv::Mat& left, const cv::Mat& right) const {
+  cv::Mat dense_depth(const cv::Ptr<cv::StereoBM>& block_matcher, const cv::Mat& left,
+                      const cv::Mat& right) const {
     cv::Mat left_half, right_half, disparity;
     cv::resize(left, left_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     cv::resize(right, right_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     // CV_16S, 16 x half-resolution disparity; no match: negative.
-    block_matcher_->compute(left_half, right_half, disparity);
+    block_matcher->compute(left_half, right_half, disparity);
     cv::Mat depth_half(disparity.size(), CV_32F);
     // z = bf / d_full = bf / (2 d_half) = bf * 16 / (2 * value).
     const float bf8 = static_cast<float>(camera_->bf * 8.0);
@@ -184,9 +248,12 @@ class StereoFrameBuilder final : public FrameBuilder {
   }
 
   StereoMatchOptions matching_;
-  cv::Ptr<cv::StereoBM> block_matcher_;
   bool dense_depth_ = false;
-  std::future<cv::Mat> dense_;
+  std::array<std::unique_ptr<ImageWork>, 2> images_;
+  int next_work_ = 0;
+  ImageWork* current_ = nullptr;  // the work of the frame being built
+  // For a depth image asked for without extract(): its own matcher, no thread shares it.
+  cv::Ptr<cv::StereoBM> block_matcher_for_calls_;
 };
 
 // One colour image: the RGB-D extraction without a depth image. No keypoint has a depth, so the

@@ -35,6 +35,12 @@ class FrameBuilder {
   virtual void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
                        OrbFeatures& features) = 0;
 
+  // The frame will be extracted after the one in progress (deterministic runs announce each
+  // frame before the one before it is processed): work that needs only its images may start
+  // now. Frames are announced in the order they are extracted; one never announced is
+  // extracted all the same.
+  virtual void prepare(const RgbdFrame&) {}
+
   // The frame's depth image (CV_32FC1 metres, 0 = none) for the dynamic pipeline: the geometry
   // stage compares it with its reference views around projected pixels and the culler reads it
   // at map points, so it must be dense. RGB-D: the sensor's image; stereo: computed here.

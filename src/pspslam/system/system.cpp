@@ -292,6 +292,7 @@ FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Ma
 }
 
 void System::announce(const RgbdFrame& frame) {
+  frame_builder_->prepare(frame);
   if (dynamic_) dynamic_->announce(frame);
 }
 

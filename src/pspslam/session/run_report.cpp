@@ -178,7 +178,8 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
     out << line;
   }
   out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
-      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv\n";
+      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv,\n"
+      << "              run_config.yaml (the config used)\n";
   std::optional<AteResult> ate_tracked;
   std::optional<AteResult> ate_refined;
   const std::optional<Trajectory>& ground_truth = input.source.ground_truth();

@@ -277,6 +277,11 @@ TEST(Config, GeometryErrorsNameFileLineAndKey) {
             strategy.string() +
                 ":15: key 'geometry.search.strategy' is not a config key: pspslam run --dynamic "
                 "chooses the search (full: ant_colony, exhaustive: every point)");
+  const auto warped = write_file(
+      dir, std::string(kValidCamera) + "geometry:\n  output_warped_previous_mask: true\n");
+  EXPECT_EQ(load_error(warped), warped.string() +
+                                    ":14: key 'geometry.output_warped_previous_mask' is not a "
+                                    "config key: a run does not use the warped mask");
   const auto band =
       write_file(dir, std::string(kValidCamera) + "geometry:\n  search:\n    band_width_px: 0\n");
   EXPECT_EQ(load_error(band),

@@ -157,10 +157,17 @@ GeometryParams read_geometry(YamlSection section) {
                 "' is not a config key: pspslam run --dynamic chooses the search (full: "
                 "ant_colony, exhaustive: every point)");
   }
+  // A library output (the previous mask warped into the frame) that a run never reads.
+  if (section.contains("output_warped_previous_mask")) {
+    throw Error(section.where("output_warped_previous_mask") + "key '" +
+                section.qualified("output_warped_previous_mask") +
+                "' is not a config key: a run does not use the warped mask");
+  }
   return GeometryParams::from_yaml(section);
 }
 
-// Every key of the geometry stage but the search strategy (chosen by --dynamic).
+// Every key of the geometry stage but the search strategy (chosen by --dynamic) and the library
+// output a run does not read (refused by read_geometry).
 void write_geometry(YAML::Emitter& out, const GeometryParams& g) {
   const auto key = [&out](const char* name) -> YAML::Emitter& {
     return out << YAML::Key << name << YAML::Value;
@@ -215,7 +222,6 @@ void write_geometry(YAML::Emitter& out, const GeometryParams& g) {
   key("older_view_gain_share") << g.references.older_view_gain_share;
   out << YAML::EndMap;
   key("previous_mask_prior") << g.previous_mask_prior;
-  key("output_warped_previous_mask") << g.output_warped_previous_mask;
   out << YAML::EndMap;
 }
 

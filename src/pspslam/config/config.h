@@ -75,7 +75,8 @@ struct SystemConfig {
   // The OC multi-view geometry stage (paper III.B/C; YAML section `geometry:` with the
   // sub-sections homography, multiview, search, region, references, every key optional). Which
   // search runs is not a key: `pspslam run --dynamic` chooses it (full: the reverse ant colony,
-  // exhaustive: every point), so `geometry.search.strategy` is refused.
+  // exhaustive: every point), so `geometry.search.strategy` is refused, as is
+  // `geometry.output_warped_previous_mask` (an output a run never reads).
   GeometryParams geometry;
 };
 

@@ -231,6 +231,20 @@ TEST(RunCommand, TracksTheStaticStretchOfBonnCrowd) {
 
 using testing::read_text;
 
+// An integer total of stats.json by its key ("dynamic_points"); -1 when absent.
+long stats_count(const std::string& stats, const std::string& key) {
+  const size_t at = stats.find("\"" + key + "\": ");
+  return at == std::string::npos ? -1L : std::stol(stats.substr(at + key.size() + 4));
+}
+
+// The synthetic room with three walking people, one carrying a box (seed 1), written to `dir`.
+void write_people_sequence(size_t frames, const std::filesystem::path& dir) {
+  SynthOptions options = static_room(frames);
+  options.bodies = 3;
+  options.threads = 0;
+  write_sequence(options, dir);
+}
+
 // Ctrl-C in the middle of `pspslam run`: the loop stops, the run still ends cleanly with status
 // 130, a parsable trajectory and a complete stats.json. The default mode (full: semantic thread
 // + geometry) runs, so the semantic thread must shut down on the way out too.
@@ -291,10 +305,7 @@ TEST(RunCommand, InterruptWritesTrajectoryAndStats) {
 // reproduce the first trajectory exactly.
 TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSequence) {
   const std::filesystem::path dir = testing::make_temp_dir("run_dynamic_geometry");
-  SynthOptions options = static_room(300);
-  options.bodies = 3;
-  options.threads = 0;
-  write_sequence(options, dir / "sequence");
+  write_people_sequence(300, dir / "sequence");
   std::string output;
   const int status = testing::run_shell(std::string(PSPSLAM_CLI_PATH) + " run --sequence " +
                                             (dir / "sequence").string() +
@@ -306,13 +317,9 @@ TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSeque
                          .error.rmse;
   EXPECT_LT(ate, 0.02) << output;
   const std::string stats = read_text(dir / "out" / "stats.json");
-  const auto total = [&](const std::string& key) {
-    const size_t at = stats.find("\"" + key + "\": ");
-    return at == std::string::npos ? -1L : std::stol(stats.substr(at + key.size() + 4));
-  };
-  EXPECT_GT(total("tested_points"), 10000) << stats;
-  EXPECT_GT(total("dynamic_points"), 500) << stats;  // people and the box were found
-  EXPECT_GT(total("masked_keypoints"), 500) << stats;
+  EXPECT_GT(stats_count(stats, "tested_points"), 10000) << stats;
+  EXPECT_GT(stats_count(stats, "dynamic_points"), 500) << stats;  // people and the box were found
+  EXPECT_GT(stats_count(stats, "masked_keypoints"), 500) << stats;
 
   // Deterministic mode repeats exactly: the geometry stage and the dynamic-point culler read
   // keyframe poses and map points only after local mapping has finished with them.
@@ -331,10 +338,7 @@ TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSeque
 // the sequence's own config finds the people.
 TEST(RunCommand, GeometryConfigSectionReachesTheStage) {
   const std::filesystem::path dir = testing::make_temp_dir("run_geometry_config");
-  SynthOptions options = static_room(60);
-  options.bodies = 3;
-  options.threads = 0;
-  write_sequence(options, dir / "sequence");
+  write_people_sequence(60, dir / "sequence");
   std::ofstream(dir / "far_only.yaml")
       << read_text(dir / "sequence" / "config.yaml")
       << "geometry:\n  multiview:\n    min_depth_m: 7.9\n    max_depth_m: 8.0\n";
@@ -345,9 +349,7 @@ TEST(RunCommand, GeometryConfigSectionReachesTheStage) {
             " --dynamic geometry --loop-closing off --out " + (dir / out).string() + extra,
         &output);
     EXPECT_EQ(status, 0) << output;
-    const std::string stats = read_text(dir / out / "stats.json");
-    const size_t at = stats.find("\"dynamic_points\": ");
-    return at == std::string::npos ? -1L : std::stol(stats.substr(at + 18));
+    return stats_count(read_text(dir / out / "stats.json"), "dynamic_points");
   };
   EXPECT_GT(dynamic_points("", "default"), 100);
   EXPECT_EQ(dynamic_points(" --config " + (dir / "far_only.yaml").string(), "far_only"), 0);

@@ -25,8 +25,8 @@ void refuse_depth_image_keys(const YamlSection& section, SensorType type) {
   for (const char* key :
        {"depth_factor", "depth_noise", "depth_noise_scale", "depth_registration_shift_px"}) {
     if (section.contains(key)) {
-      throw Error(section.where(key) + "key '" + section.qualified(key) +
-                  "' is for rgbd cameras only (camera.type is " + to_string(type) + ")");
+      throw section.invalid(key,
+                            "is for rgbd cameras only (camera.type is " + to_string(type) + ")");
     }
   }
 }
@@ -79,19 +79,18 @@ CameraConfig read_camera(YamlSection section) {
   require_positive(camera.fps, section, "fps");
   camera.rolling_shutter_readout_s = section.optional("rolling_shutter_readout", 0.0);
   if (!(std::abs(camera.rolling_shutter_readout_s) <= 1.0 / camera.fps)) {
-    throw Error(section.where("rolling_shutter_readout") + "key '" +
-                section.qualified("rolling_shutter_readout") +
-                "' must be seconds within +-1/fps (a sensor reads its rows within one frame; "
-                "negative: bottom row first), got " +
-                std::to_string(camera.rolling_shutter_readout_s));
+    throw section.invalid("rolling_shutter_readout",
+                          "must be seconds within +-1/fps (a sensor reads its rows within one "
+                          "frame; negative: bottom row first), got " +
+                              std::to_string(camera.rolling_shutter_readout_s));
   }
   if (camera.type == SensorType::monocular) {
     // No depth at all: nothing is "close" or "far" (depth_threshold is not read).
     refuse_depth_image_keys(section, camera.type);
     for (const char* key : {"baseline", "bf", "depth_threshold"}) {
       if (section.contains(key)) {
-        throw Error(section.where(key) + "key '" + section.qualified(key) +
-                    "' has no meaning for a monocular camera (camera.type is monocular)");
+        throw section.invalid(key,
+                              "has no meaning for a monocular camera (camera.type is monocular)");
       }
     }
     section.finish();
@@ -153,15 +152,14 @@ OrbConfig read_orb(YamlSection section) {
 GeometryParams read_geometry(YamlSection section) {
   YamlSection search = section.section("search");
   if (search.contains("strategy")) {
-    throw Error(search.where("strategy") + "key '" + search.qualified("strategy") +
-                "' is not a config key: pspslam run --dynamic chooses the search (full: "
-                "ant_colony, exhaustive: every point)");
+    throw search.invalid("strategy",
+                         "is not a config key: pspslam run --dynamic chooses the search (full: "
+                         "ant_colony, exhaustive: every point)");
   }
   // A library output (the previous mask warped into the frame) that a run never reads.
   if (section.contains("output_warped_previous_mask")) {
-    throw Error(section.where("output_warped_previous_mask") + "key '" +
-                section.qualified("output_warped_previous_mask") +
-                "' is not a config key: a run does not use the warped mask");
+    throw section.invalid("output_warped_previous_mask",
+                          "is not a config key: a run does not use the warped mask");
   }
   return GeometryParams::from_yaml(section);
 }

@@ -26,6 +26,10 @@ std::string YamlSection::where(const std::string& key) const {
   return file_ + ":" + std::to_string(node_[key].Mark().line + 1) + ": ";
 }
 
+Error YamlSection::invalid(const std::string& key, const std::string& what) const {
+  return Error(where(key) + "key '" + qualified(key) + "' " + what);
+}
+
 YamlSection YamlSection::section(const std::string& key) {
   used_.insert(key);
   const YAML::Node child = node_ && node_.IsMap() ? node_[key] : YAML::Node();

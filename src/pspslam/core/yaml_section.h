@@ -21,6 +21,12 @@ class YamlSection {
   bool contains(const std::string& key) const;
   // "<file>:<line>: " of a key that is present ("<file>: " when it is not).
   std::string where(const std::string& key) const;
+  // A key whose value is not allowed: "<file>:<line>: key '<section.key>' <what>".
+  Error invalid(const std::string& key, const std::string& what) const;
+  // Throws invalid(key, what) unless `ok`.
+  void require(bool ok, const std::string& key, const std::string& what) const {
+    if (!ok) throw invalid(key, what);
+  }
 
   template <typename T>
   T required(const std::string& key) {

@@ -8,13 +8,6 @@
 #include "pspslam/geometry/convex_hull.h"
 
 namespace pspslam {
-namespace {
-
-void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
-}
-
-}  // namespace
 
 AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
   AntColonyParams p;
@@ -24,20 +17,19 @@ AntColonyParams AntColonyParams::from_yaml(YamlSection& section) {
   } else if (strategy == "exhaustive") {
     p.strategy = SearchStrategy::exhaustive;
   } else {
-    throw Error(section.where("strategy") + "key '" + section.qualified("strategy") + "' must be " +
-                "ant_colony or exhaustive, not '" + strategy + "'");
+    throw section.invalid("strategy", "must be ant_colony or exhaustive, not '" + strategy + "'");
   }
   p.search_radius_px = section.optional("search_radius_px", p.search_radius_px);
-  require(p.search_radius_px > 0.0f, section, "search_radius_px", "must be > 0");
+  section.require(p.search_radius_px > 0.0f, "search_radius_px", "must be > 0");
   p.band_width_px = section.optional("band_width_px", p.band_width_px);
-  require(p.band_width_px > 0.0f, section, "band_width_px", "must be > 0");
+  section.require(p.band_width_px > 0.0f, "band_width_px", "must be > 0");
   p.node_spacing_px = section.optional("node_spacing_px", p.node_spacing_px);
-  require(p.node_spacing_px > 0.0f, section, "node_spacing_px", "must be > 0");
+  section.require(p.node_spacing_px > 0.0f, "node_spacing_px", "must be > 0");
   p.lane_spacing_px = section.optional("lane_spacing_px", p.lane_spacing_px);
-  require(p.lane_spacing_px > 0.0f, section, "lane_spacing_px", "must be > 0");
+  section.require(p.lane_spacing_px > 0.0f, "lane_spacing_px", "must be > 0");
   p.alternate_lanes = section.optional("alternate_lanes", p.alternate_lanes);
   p.max_band_rounds = section.optional("max_band_rounds", p.max_band_rounds);
-  require(p.max_band_rounds >= 1, section, "max_band_rounds", "must be >= 1");
+  section.require(p.max_band_rounds >= 1, "max_band_rounds", "must be >= 1");
   section.finish();
   return p;
 }

@@ -18,10 +18,6 @@ namespace {
 using Vector8d = Eigen::Matrix<double, 8, 1>;
 using Matrix8d = Eigen::Matrix<double, 8, 8>;
 
-void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
-}
-
 // Hartley normalisation: centroid to the origin, mean distance sqrt(2). Without it the DLT and
 // the LM normal equations mix pixel coordinates (~600) with ones and lose ~6 digits.
 Eigen::Matrix3d normalising_transform(std::span<const Eigen::Vector2d> points,
@@ -187,14 +183,14 @@ int refine_levenberg_marquardt(std::span<const Eigen::Vector2d> x,
 HomographyParams HomographyParams::from_yaml(YamlSection& section) {
   HomographyParams p;
   p.inlier_threshold_px = section.optional("inlier_threshold_px", p.inlier_threshold_px);
-  require(p.inlier_threshold_px > 0.0, section, "inlier_threshold_px", "must be > 0");
+  section.require(p.inlier_threshold_px > 0.0, "inlier_threshold_px", "must be > 0");
   p.max_ransac_iterations = section.optional("max_ransac_iterations", p.max_ransac_iterations);
-  require(p.max_ransac_iterations >= 1, section, "max_ransac_iterations", "must be >= 1");
+  section.require(p.max_ransac_iterations >= 1, "max_ransac_iterations", "must be >= 1");
   p.ransac_confidence = section.optional("ransac_confidence", p.ransac_confidence);
-  require(p.ransac_confidence > 0.0 && p.ransac_confidence < 1.0, section, "ransac_confidence",
-          "must be in (0, 1)");
+  section.require(p.ransac_confidence > 0.0 && p.ransac_confidence < 1.0, "ransac_confidence",
+                  "must be in (0, 1)");
   p.lm_max_iterations = section.optional("lm_max_iterations", p.lm_max_iterations);
-  require(p.lm_max_iterations >= 0, section, "lm_max_iterations", "must be >= 0");
+  section.require(p.lm_max_iterations >= 0, "lm_max_iterations", "must be >= 0");
   p.random_seed = section.optional<std::uint64_t>("random_seed", p.random_seed);
   section.finish();
   return p;

@@ -46,18 +46,14 @@ GeometryParams GeometryParams::from_yaml(YamlSection& section) {
   YamlSection references = section.section("references");
   p.references.wanted_coverage =
       references.optional("wanted_coverage", p.references.wanted_coverage);
-  if (p.references.wanted_coverage < 1)
-    throw Error(references.where("wanted_coverage") + "key '" +
-                references.qualified("wanted_coverage") + "' must be >= 1");
+  references.require(p.references.wanted_coverage >= 1, "wanted_coverage", "must be >= 1");
   p.references.point_stride = references.optional("point_stride", p.references.point_stride);
-  if (p.references.point_stride < 1)
-    throw Error(references.where("point_stride") + "key '" + references.qualified("point_stride") +
-                "' must be >= 1");
+  references.require(p.references.point_stride >= 1, "point_stride", "must be >= 1");
   p.references.older_view_gain_share =
       references.optional("older_view_gain_share", p.references.older_view_gain_share);
-  if (!(p.references.older_view_gain_share > 0.0 && p.references.older_view_gain_share <= 1.0))
-    throw Error(references.where("older_view_gain_share") + "key '" +
-                references.qualified("older_view_gain_share") + "' must be in (0, 1]");
+  references.require(
+      p.references.older_view_gain_share > 0.0 && p.references.older_view_gain_share <= 1.0,
+      "older_view_gain_share", "must be in (0, 1]");
   references.finish();
   p.previous_mask_prior = section.optional("previous_mask_prior", p.previous_mask_prior);
   p.output_warped_previous_mask =

@@ -8,48 +8,41 @@
 #include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
-namespace {
-
-void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
-}
-
-}  // namespace
 
 MultiViewParams MultiViewParams::from_yaml(YamlSection& section) {
   MultiViewParams p;
   p.depth_threshold_abs_m = section.optional("depth_threshold_abs_m", p.depth_threshold_abs_m);
-  require(p.depth_threshold_abs_m >= 0.0, section, "depth_threshold_abs_m", "must be >= 0");
+  section.require(p.depth_threshold_abs_m >= 0.0, "depth_threshold_abs_m", "must be >= 0");
   p.depth_threshold_relative =
       section.optional("depth_threshold_relative", p.depth_threshold_relative);
-  require(p.depth_threshold_relative >= 0.0, section, "depth_threshold_relative", "must be >= 0");
-  require(p.depth_threshold_abs_m + p.depth_threshold_relative > 0.0, section,
-          "depth_threshold_relative", "and depth_threshold_abs_m cannot both be 0");
+  section.require(p.depth_threshold_relative >= 0.0, "depth_threshold_relative", "must be >= 0");
+  section.require(p.depth_threshold_abs_m + p.depth_threshold_relative > 0.0,
+                  "depth_threshold_relative", "and depth_threshold_abs_m cannot both be 0");
   const std::string disagreement = section.optional<std::string>("disagreement", "farther_only");
   if (disagreement == "farther_only") {
     p.disagreement = DepthDisagreement::farther_only;
   } else if (disagreement == "either_sign") {
     p.disagreement = DepthDisagreement::either_sign;
   } else {
-    throw Error(section.where("disagreement") + "key '" + section.qualified("disagreement") +
-                "' must be farther_only or either_sign, not '" + disagreement + "'");
+    throw section.invalid("disagreement",
+                          "must be farther_only or either_sign, not '" + disagreement + "'");
   }
   p.max_parallax_deg = section.optional("max_parallax_deg", p.max_parallax_deg);
-  require(p.max_parallax_deg > 0.0 && p.max_parallax_deg <= 180.0, section, "max_parallax_deg",
-          "must be in (0, 180]");
+  section.require(p.max_parallax_deg > 0.0 && p.max_parallax_deg <= 180.0, "max_parallax_deg",
+                  "must be in (0, 180]");
   p.reference_patch_radius = section.optional("reference_patch_radius", p.reference_patch_radius);
-  require(p.reference_patch_radius >= 0 && p.reference_patch_radius <= 10, section,
-          "reference_patch_radius", "must be in [0, 10]");
+  section.require(p.reference_patch_radius >= 0 && p.reference_patch_radius <= 10,
+                  "reference_patch_radius", "must be in [0, 10]");
   p.min_dynamic_vote_fraction =
       section.optional("min_dynamic_vote_fraction", p.min_dynamic_vote_fraction);
-  require(p.min_dynamic_vote_fraction > 0.0 && p.min_dynamic_vote_fraction <= 1.0, section,
-          "min_dynamic_vote_fraction", "must be in (0, 1]");
+  section.require(p.min_dynamic_vote_fraction > 0.0 && p.min_dynamic_vote_fraction <= 1.0,
+                  "min_dynamic_vote_fraction", "must be in (0, 1]");
   p.max_reference_views = section.optional("max_reference_views", p.max_reference_views);
-  require(p.max_reference_views >= 1, section, "max_reference_views", "must be >= 1");
+  section.require(p.max_reference_views >= 1, "max_reference_views", "must be >= 1");
   p.min_depth_m = section.optional("min_depth_m", p.min_depth_m);
-  require(p.min_depth_m > 0.0, section, "min_depth_m", "must be > 0");
+  section.require(p.min_depth_m > 0.0, "min_depth_m", "must be > 0");
   p.max_depth_m = section.optional("max_depth_m", p.max_depth_m);
-  require(p.max_depth_m > p.min_depth_m, section, "max_depth_m", "must be > min_depth_m");
+  section.require(p.max_depth_m > p.min_depth_m, "max_depth_m", "must be > min_depth_m");
   section.finish();
   return p;
 }

@@ -9,38 +9,31 @@
 #include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
-namespace {
-
-void require(bool ok, const YamlSection& section, const std::string& key, const char* what) {
-  if (!ok) throw Error(section.where(key) + "key '" + section.qualified(key) + "' " + what);
-}
-
-}  // namespace
 
 RegionGrowParams RegionGrowParams::from_yaml(YamlSection& section) {
   RegionGrowParams p;
   p.enabled = section.optional("enabled", p.enabled);
   p.stride = section.optional("stride", p.stride);
-  require(p.stride >= 1 && p.stride <= 16, section, "stride", "must be in [1, 16]");
+  section.require(p.stride >= 1 && p.stride <= 16, "stride", "must be in [1, 16]");
   p.max_step_abs_m = section.optional("max_step_abs_m", p.max_step_abs_m);
-  require(p.max_step_abs_m >= 0.0, section, "max_step_abs_m", "must be >= 0");
+  section.require(p.max_step_abs_m >= 0.0, "max_step_abs_m", "must be >= 0");
   p.max_step_relative = section.optional("max_step_relative", p.max_step_relative);
-  require(p.max_step_relative >= 0.0, section, "max_step_relative", "must be >= 0");
+  section.require(p.max_step_relative >= 0.0, "max_step_relative", "must be >= 0");
   p.max_depth_from_seed_m = section.optional("max_depth_from_seed_m", p.max_depth_from_seed_m);
-  require(p.max_depth_from_seed_m > 0.0, section, "max_depth_from_seed_m", "must be > 0");
+  section.require(p.max_depth_from_seed_m > 0.0, "max_depth_from_seed_m", "must be > 0");
   p.max_grow_radius_px = section.optional("max_grow_radius_px", p.max_grow_radius_px);
-  require(p.max_grow_radius_px > 0.0f, section, "max_grow_radius_px", "must be > 0");
+  section.require(p.max_grow_radius_px > 0.0f, "max_grow_radius_px", "must be > 0");
   p.max_grow_radius_m = section.optional("max_grow_radius_m", p.max_grow_radius_m);
-  require(p.max_grow_radius_m >= 0.0f, section, "max_grow_radius_m", "must be >= 0");
+  section.require(p.max_grow_radius_m >= 0.0f, "max_grow_radius_m", "must be >= 0");
   p.min_seeds_per_region = section.optional("min_seeds_per_region", p.min_seeds_per_region);
-  require(p.min_seeds_per_region >= 1, section, "min_seeds_per_region", "must be >= 1");
+  section.require(p.min_seeds_per_region >= 1, "min_seeds_per_region", "must be >= 1");
   p.max_region_samples = section.optional("max_region_samples", p.max_region_samples);
-  require(p.max_region_samples >= 1, section, "max_region_samples", "must be >= 1");
+  section.require(p.max_region_samples >= 1, "max_region_samples", "must be >= 1");
   p.static_barrier_radius_px =
       section.optional("static_barrier_radius_px", p.static_barrier_radius_px);
-  require(p.static_barrier_radius_px >= 0.0f, section, "static_barrier_radius_px", "must be >= 0");
+  section.require(p.static_barrier_radius_px >= 0.0f, "static_barrier_radius_px", "must be >= 0");
   p.dilation_px = section.optional("dilation_px", p.dilation_px);
-  require(p.dilation_px >= 0, section, "dilation_px", "must be >= 0");
+  section.require(p.dilation_px >= 0, "dilation_px", "must be >= 0");
   section.finish();
   return p;
 }

@@ -4,6 +4,8 @@
 #include <string>
 
 #include "pspslam/core/error.h"
+#include "pspslam/io/trajectory_io.h"
+#include "pspslam/session/frame_log.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/session/start_watch.h"
@@ -93,6 +95,69 @@ TEST(RunStatistics, FindsTheLongestLostStretchAfterTheMapStarted) {
   never_lost.add_frame(0, frame(true, TrackingMethod::kInitialization), 0.0);
   EXPECT_EQ(never_lost.lost_stretches(), 0u);
   EXPECT_FALSE(never_lost.longest_lost_stretch());
+}
+
+// A monocular map that starts at frame 3 places frames 1 and 2 (frame 0 was too early to be
+// kept): they count as posed, and the latest start's count is reported.
+TEST(RunStatistics, FramesPlacedByTheMapStartCountAsPosed) {
+  RunStatistics stats(DynamicMode::full, std::nullopt);
+  FrameReport before_map;
+  for (size_t i = 0; i < 3; ++i) stats.add_frame(i, before_map, 0.0);
+  EXPECT_EQ(stats.lost(), 3u);
+  FrameReport start = frame(true, TrackingMethod::kInitialization);
+  start.tracking.earlier_frames = {{1.0, Pose::Identity()}, {2.0, Pose::Identity()}};
+  stats.add_frame(3, start, 0.0);
+  stats.add_frame(4, frame(true), 0.0);
+  EXPECT_EQ(stats.processed(), 5u);
+  EXPECT_EQ(stats.lost(), 1u);
+  EXPECT_EQ(stats.placed_before_initialisation(), 2u);
+  EXPECT_EQ(stats.tracked_since_initialisation(), 2u);
+  ASSERT_TRUE(stats.initialised_at());
+  EXPECT_EQ(*stats.initialised_at(), 3u);
+  // A restart moves every pose of the map it drops, the placed ones too, back to "without pose".
+  FrameReport restart = frame(false);
+  restart.tracking.restart_due = true;
+  stats.add_frame(5, restart, 0.0);
+  EXPECT_EQ(stats.lost(), 6u);
+}
+
+// The frames placed by the map's start leave lost_frames.txt and enter trajectory.txt ahead of
+// the frame that started it; a later restart lists every pose of the dropped map as restarted.
+TEST(FrameLog, EarlierFramesMoveFromLostFramesToTheTrajectoryInTimeOrder) {
+  const auto dir = testing::make_temp_dir("frame_log_earlier");
+  FrameLog log(dir);
+  const MappingStats mapping;
+  FrameReport before_map;
+  for (size_t i = 0; i < 4; ++i)
+    log.write(i, 10.0 + 0.5 * static_cast<double>(i), before_map, 0.0, mapping, std::nullopt);
+  Pose placed = Pose::Identity();
+  placed.translation() = Eigen::Vector3d(0.1, 0.0, 0.0);
+  log.write_earlier({{11.0, Pose::Identity()}, {11.5, placed}});
+  FrameReport start = frame(true, TrackingMethod::kInitialization);
+  start.tracking.T_world_camera->translation() = Eigen::Vector3d(0.2, 0.0, 0.0);
+  log.write(4, 12.0, start, 0.0, mapping, std::nullopt);
+  EXPECT_EQ(log.poses(), 3u);
+
+  const Trajectory trajectory = read_tum_trajectory(dir / "trajectory.txt");
+  ASSERT_EQ(trajectory.size(), 3u);
+  EXPECT_DOUBLE_EQ(trajectory[0].timestamp, 11.0);
+  EXPECT_DOUBLE_EQ(trajectory[1].timestamp, 11.5);
+  EXPECT_NEAR(trajectory[1].T_world_camera.translation().x(), 0.1, 1e-9);
+  EXPECT_DOUBLE_EQ(trajectory[2].timestamp, 12.0);
+  EXPECT_EQ(testing::read_text(dir / "lost_frames.txt"),
+            "# frames without a pose (tracking not initialised or lost): index timestamp state\n"
+            "0 10.000000 not_initialized\n"
+            "1 10.500000 not_initialized\n");
+
+  log.forget_poses();
+  EXPECT_EQ(log.poses(), 0u);
+  EXPECT_EQ(testing::read_text(dir / "lost_frames.txt"),
+            "# frames without a pose (tracking not initialised or lost): index timestamp state\n"
+            "0 10.000000 not_initialized\n"
+            "1 10.500000 not_initialized\n"
+            "2 11.000000 restarted\n"
+            "3 11.500000 restarted\n"
+            "4 12.000000 restarted\n");
 }
 
 TEST(StartWatch, WarnsOnceAfterTheGivenFramesAndSaysWhy) {

@@ -1,5 +1,6 @@
 #include "pspslam/session/frame_log.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "pspslam/core/error.h"
@@ -12,11 +13,17 @@ std::ofstream open_output(const std::filesystem::path& file) {
   return stream;
 }
 
+namespace {
+constexpr const char* kLostHeader =
+    "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
+}  // namespace
+
 FrameLog::FrameLog(const std::filesystem::path& folder)
     : trajectory_(folder / "trajectory.txt"),
-      lost_(open_output(folder / "lost_frames.txt")),
+      lost_path_(folder / "lost_frames.txt"),
+      lost_(open_output(lost_path_)),
       timing_(open_output(folder / "timing.csv")) {
-  lost_ << "# frames without a pose (tracking not initialised or lost): index timestamp state\n";
+  lost_ << kLostHeader;
   timing_
       << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
          "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_"
@@ -32,9 +39,8 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
     trajectory_.write(timestamp, *result.T_world_camera);
     posed_.emplace_back(index, timestamp);
   } else {
-    char line[96];
-    std::snprintf(line, sizeof(line), "%zu %.6f %s\n", index, timestamp, to_string(result.state));
-    lost_ << line << std::flush;
+    write_lost({index, timestamp, to_string(result.state)});
+    lost_ << std::flush;
   }
   const DynamicReport& dyn = report.dynamic;
   char row[384];
@@ -56,13 +62,37 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
   timing_ << '\n';
 }
 
+void FrameLog::write_lost(const LostLine& line) {
+  char text[96];
+  std::snprintf(text, sizeof(text), "%zu %.6f %s\n", line.index, line.timestamp, line.state);
+  lost_ << text;
+  lost_lines_.push_back(line);
+}
+
+void FrameLog::write_earlier(const std::vector<StampedPose>& poses) {
+  if (poses.empty()) return;
+  for (const StampedPose& pose : poses) {
+    // The frame was written as lost when it was processed (same timestamp, bit for bit).
+    const auto line = std::find_if(lost_lines_.begin(), lost_lines_.end(), [&](const LostLine& l) {
+      return l.timestamp == pose.timestamp;
+    });
+    if (line == lost_lines_.end()) continue;
+    trajectory_.write(pose);
+    posed_.emplace_back(line->index, pose.timestamp);
+    lost_lines_.erase(line);
+  }
+  std::vector<LostLine> kept;
+  kept.swap(lost_lines_);
+  lost_.close();
+  lost_ = open_output(lost_path_);
+  lost_ << kLostHeader;
+  for (const LostLine& line : kept) write_lost(line);
+  lost_ << std::flush;
+}
+
 void FrameLog::forget_poses() {
   trajectory_.clear();
-  for (const auto& [index, timestamp] : posed_) {
-    char line[96];
-    std::snprintf(line, sizeof(line), "%zu %.6f restarted\n", index, timestamp);
-    lost_ << line;
-  }
+  for (const auto& [index, timestamp] : posed_) write_lost({index, timestamp, "restarted"});
   lost_ << std::flush;
   posed_.clear();
 }

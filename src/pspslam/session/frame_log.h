@@ -32,6 +32,11 @@ class FrameLog {
   void write(size_t index, Timestamp timestamp, const FrameReport& report, double local_ba_ms,
              const MappingStats& mapping, std::optional<double> arrival_to_pose_ms);
 
+  // The frame just started the map and placed earlier frames (TrackResult::earlier_frames, oldest
+  // first): their poses go to trajectory.txt ahead of the frame's own, and they leave
+  // lost_frames.txt (rewritten). Call before write() of the frame that started the map.
+  void write_earlier(const std::vector<StampedPose>& poses);
+
   size_t poses() const { return trajectory_.count(); }
   // A monocular map was restarted (TrackResult::restart_due) by the frame just written: the
   // poses tracked in it leave trajectory.txt and are listed in lost_frames.txt as `restarted`.
@@ -39,7 +44,16 @@ class FrameLog {
 
  private:
   TrajectoryWriter trajectory_;
+  struct LostLine {
+    size_t index = 0;
+    Timestamp timestamp = 0.0;
+    const char* state = "";
+  };
+  void write_lost(const LostLine& line);
+
   std::vector<std::pair<size_t, Timestamp>> posed_;  // index, time of each line of trajectory_
+  std::filesystem::path lost_path_;
+  std::vector<LostLine> lost_lines_;  // every line of lost_, so that it can be rewritten
   std::ofstream lost_;
   std::ofstream timing_;
 };

@@ -156,9 +156,11 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
     } else if (stats.initialised_at()) {
       const size_t since = stats.processed_since_initialisation();
       std::snprintf(line, sizeof(line),
-                    "monocular:    map started at frame %zu; %zu of %zu frames tracked from "
-                    "there (%.1f %%), %zu map restarts\n",
-                    *stats.initialised_at(), stats.tracked_since_initialisation(), since,
+                    "monocular:    map started at frame %zu (%zu frames before it placed in the "
+                    "first map); %zu of %zu frames tracked from there (%.1f %%), %zu map "
+                    "restarts\n",
+                    *stats.initialised_at(), stats.placed_before_initialisation(),
+                    stats.tracked_since_initialisation(), since,
                     since > 0 ? 100.0 * stats.tracked_since_initialisation() / since : 0.0,
                     stats.map_restarts());
     } else {
@@ -269,6 +271,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                                                  : nlohmann::ordered_json(nullptr)},
                          {"frames_since_initialisation", stats.processed_since_initialisation()},
                          {"tracked_since_initialisation", stats.tracked_since_initialisation()},
+                         {"placed_before_initialisation", stats.placed_before_initialisation()},
                          {"map_restarts", stats.map_restarts()},
                          {"map_loaded", map_loaded}};
   }

@@ -60,7 +60,12 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     lost_ += posed_in_this_map_;
     posed_in_this_map_ = 0;
   }
+  // Frames before the start that the new map placed had been counted as without a pose.
+  const size_t placed = std::min(result.earlier_frames.size(), lost_);
+  lost_ -= placed;
+  posed_in_this_map_ += placed;
   if (result.method == TrackingMethod::kInitialization) {
+    placed_before_initialisation_ = placed;
     initialised_at_ = index;
     tracked_since_initialisation_ = 0;
     processed_since_initialisation_ = 0;

@@ -57,6 +57,8 @@ class RunStatistics {
   // and the frames with a pose from there on, of the frames processed from there on.
   std::optional<size_t> initialised_at() const { return initialised_at_; }
   size_t tracked_since_initialisation() const { return tracked_since_initialisation_; }
+  // Frames before the map's start that it placed (TrackResult::earlier_frames; monocular).
+  size_t placed_before_initialisation() const { return placed_before_initialisation_; }
   size_t processed_since_initialisation() const { return processed_since_initialisation_; }
   size_t map_restarts() const { return map_restarts_; }
   // Consecutive frames lost after the map existed (frames before it started do not count):
@@ -107,6 +109,7 @@ class RunStatistics {
   std::string first_method_after_blackout_;
   std::optional<size_t> initialised_at_;
   size_t tracked_since_initialisation_ = 0;
+  size_t placed_before_initialisation_ = 0;
   size_t processed_since_initialisation_ = 0;
   size_t map_restarts_ = 0;
   size_t lost_stretches_ = 0;

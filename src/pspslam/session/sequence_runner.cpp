@@ -197,6 +197,9 @@ RunOutcome SequenceRunner::run() {
       exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
                                    system_->last_dynamic_mask());
     if (start_watch.update(result)) spdlog::warn("{}", start_watch.reason());
+    // The frame that started a monocular map also placed frames before it (oldest first).
+    estimate_.insert(estimate_.end(), result.earlier_frames.begin(), result.earlier_frames.end());
+    log_.write_earlier(result.earlier_frames);
     if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
     const MappingStats mapping = system_->mapping_stats();
     const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;

@@ -281,8 +281,11 @@ class MonocularFrameBuilder final : public FrameBuilder {
                  std::move(features.descriptors), cv::Mat(), camera_, pyramid_, angular_velocity);
   }
 
-  std::unique_ptr<MapInitializer> make_map_initializer(const TrackerOptions&) const override {
-    return make_monocular_map_initializer();
+  std::unique_ptr<MapInitializer> make_map_initializer(
+      const TrackerOptions& tracker) const override {
+    MonocularInitializerOptions options;
+    options.pose_optimizer = tracker.pose_optimizer;
+    return make_monocular_map_initializer(options);
   }
 
   void adapt(LocalMappingOptions& options) const override {

@@ -11,6 +11,7 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/match/orb_matcher.h"
 #include "pspslam/optimize/global_bundle_adjustment.h"
+#include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 
 namespace pspslam {
@@ -44,7 +45,7 @@ class MonocularMapInitializer final : public MapInitializer {
   std::vector<std::shared_ptr<KeyFrame>> initialize(Frame& frame, Map& map,
                                                     InitializationProgress& progress) override {
     if (frame.size() < options_.min_keypoints) {
-      reference_.reset();
+      reset();
       return {};
     }
     if (!reference_) {
@@ -72,7 +73,10 @@ class MonocularMapInitializer final : public MapInitializer {
     const TwoViewResult two_view = initialize_two_view(frame.camera().pinhole, first_pixels_,
                                                        second_pixels_, options_.two_view);
     progress.model = two_view.model;
-    if (!two_view.success) return {};
+    if (!two_view.success) {
+      remember_between(frame);
+      return {};
+    }
     std::vector<std::shared_ptr<KeyFrame>> keyframes = build_map(frame, map, two_view);
     if (keyframes.empty()) {
       map.clear();
@@ -80,16 +84,67 @@ class MonocularMapInitializer final : public MapInitializer {
       std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
       take_as_reference(frame);
     } else {
+      localise_between(*keyframes.front());
       reference_.reset();
     }
     return keyframes;
   }
 
+  std::vector<EarlierFramePose> take_earlier_frames() override { return std::move(earlier_); }
+
   std::size_t restart_when_lost_below() const override { return options_.restart_when_lost_below; }
-  void reset() override { reference_.reset(); }
+  void reset() override {
+    reference_.reset();
+    between_.clear();
+    earlier_.clear();
+  }
 
  private:
+  // A frame matched with the reference that did not start the map: kept with its matches so that
+  // the map, once started, can place it.
+  struct FrameBetween {
+    Frame frame;
+    std::vector<int> match_of_reference;
+  };
+
+  void remember_between(const Frame& frame) {
+    if (between_.size() >= options_.max_earlier_frames) return;
+    between_.push_back({frame, match_of_reference_});
+  }
+
+  // The reference (the first keyframe, at the origin) and the frames kept since it, each from the
+  // pose of the one before: a pose-only optimisation on the first keyframe's points its
+  // reference matches reached, as tracking does with its matches (outliers by the same chi2
+  // rounds). A frame that keeps too few inliers stays without a pose.
+  void localise_between(const KeyFrame& first) {
+    earlier_.clear();
+    earlier_.push_back({reference_->timestamp(), Pose::Identity(), /*is_first_keyframe=*/true});
+    Pose previous = Pose::Identity();
+    for (FrameBetween& between : between_) {
+      Frame& frame = between.frame;
+      std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+      int matched = 0;
+      for (size_t i = 0; i < between.match_of_reference.size(); ++i) {
+        const int j = between.match_of_reference[i];
+        if (j < 0) continue;
+        std::shared_ptr<MapPoint> point = first.map_point(static_cast<int>(i));
+        if (!point || point->is_bad()) continue;
+        frame.map_points[static_cast<size_t>(j)] = std::move(point);
+        ++matched;
+      }
+      if (matched < options_.min_earlier_frame_inliers) continue;
+      frame.set_pose(previous);
+      const PoseOptimizationResult optimized =
+          optimize_frame_pose(frame, options_.pose_optimizer, pose_buffers_);
+      if (optimized.num_inliers < options_.min_earlier_frame_inliers) continue;
+      previous = frame.T_camera_world();
+      earlier_.push_back({frame.timestamp(), previous, /*is_first_keyframe=*/false});
+    }
+    between_.clear();
+  }
+
   void take_as_reference(const Frame& frame) {
+    between_.clear();
     reference_.emplace(frame);
     last_position_.resize(static_cast<size_t>(frame.size()));
     for (int i = 0; i < frame.size(); ++i)
@@ -221,6 +276,9 @@ class MonocularMapInitializer final : public MapInitializer {
 
   MonocularInitializerOptions options_;
   std::optional<Frame> reference_;
+  std::vector<FrameBetween> between_;      // matched with reference_ since it was taken
+  std::vector<EarlierFramePose> earlier_;  // placed by the last successful start
+  FramePoseBuffers pose_buffers_;
   std::vector<cv::Point2f> last_position_;  // per reference keypoint
   // Per-attempt buffers, reused.
   std::vector<int> match_of_reference_;

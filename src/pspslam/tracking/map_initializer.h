@@ -4,6 +4,8 @@
 #include <memory>
 #include <vector>
 
+#include "pspslam/core/types.h"
+#include "pspslam/optimize/pose_optimizer.h"
 #include "pspslam/solve/two_view_initializer.h"
 
 namespace pspslam {
@@ -23,6 +25,13 @@ struct InitializationProgress {
   TwoViewModel model = TwoViewModel::none;
 };
 
+// A frame before the map's start, placed in the new map once it exists.
+struct EarlierFramePose {
+  Timestamp timestamp = 0.0;
+  Pose T_camera_world = Pose::Identity();
+  bool is_first_keyframe = false;  // the frame the first keyframe was made from
+};
+
 // How the map starts: the one step of tracking that differs between the sensors (past it every
 // keypoint is (u, v, depth, right u) for all of them, depth < 0 without one). The sensor's
 // initialiser comes from its FrameBuilder (system/frame_builder.h).
@@ -35,6 +44,11 @@ class MapInitializer {
   // tracker's reference keyframe; each goes to local mapping). Empty: not yet.
   virtual std::vector<std::shared_ptr<KeyFrame>> initialize(Frame& frame, Map& map,
                                                             InitializationProgress& progress) = 0;
+
+  // After a successful initialize(): the frames before `frame` that the new map can place, oldest
+  // first (monocular: the two-view pair's first frame and the frames between the pair, localised
+  // on the first map's points). Each call hands them over once; empty for a one-frame start.
+  virtual std::vector<EarlierFramePose> take_earlier_frames() { return {}; }
 
   // Tracking lost while the map has at most this many keyframes starts a new map (0: never).
   virtual std::size_t restart_when_lost_below() const { return 0; }
@@ -56,13 +70,22 @@ struct MonocularInitializerOptions {
   // ORB-SLAM resets a monocular map lost with this few keyframes.
   std::size_t restart_when_lost_below = 5;
   TwoViewOptions two_view;
+  // The frames between the pair get a pose in the first map (take_earlier_frames): at most this
+  // many are kept while waiting for parallax (3 s at 30 fps; older ones stay without a pose), and
+  // one is placed when its pose-only optimisation keeps this many inlier points (tracking's
+  // minimum).
+  std::size_t max_earlier_frames = 90;
+  int min_earlier_frame_inliers = 30;
+  PoseOptimizerOptions pose_optimizer;
 };
 
 // Two frames with parallax start the map (ORB-SLAM's monocular initialisation): the first frame
 // with enough keypoints becomes the reference, later frames are matched to it until the
 // two-view solver (solve/two_view_initializer.h) accepts a pair; the pair's points are
 // triangulated, both keyframes and the points are bundle adjusted, and the map is scaled to a
-// median depth of 1 in the first keyframe.
+// median depth of 1 in the first keyframe. The frames in between, matched with the first frame
+// while parallax grew, are then localised on the points their matches reached (ORB-SLAM leaves
+// them without a pose: on the synthetic demo sequence 16 of 300 frames).
 std::unique_ptr<MapInitializer> make_monocular_map_initializer(
     MonocularInitializerOptions options = {});
 

@@ -185,6 +185,14 @@ bool Tracker::initialize(Frame& frame, TrackResult& result) {
   result.initialization_matches = progress.initialization_matches;
   result.initialization_model = progress.model;
   if (keyframes.empty()) return false;
+  // Earlier frames the new map placed, anchored to the first keyframe like tracked frames to
+  // their reference, so that the refined trajectory moves them with it.
+  const std::shared_ptr<KeyFrame>& first = keyframes.front();
+  for (const EarlierFramePose& earlier : initializer_->take_earlier_frames()) {
+    result.earlier_frames.push_back({earlier.timestamp, earlier.T_camera_world.inverse()});
+    anchors_.push_back({earlier.timestamp, first, earlier.T_camera_world * first->T_world_camera(),
+                        earlier.T_camera_world, earlier.is_first_keyframe, map_epoch_});
+  }
   reference_keyframe_ = keyframes.back();
   last_keyframe_frame_id_ = frame.id();
   local_map_.update(frame);

@@ -90,6 +90,10 @@ struct TrackResult {
   // two-view model tried on them (none: no attempt).
   int initialization_matches = 0;
   TwoViewModel initialization_model = TwoViewModel::none;
+  // The frame that started the map (method kInitialization): earlier frames the new map placed
+  // (MapInitializer::take_earlier_frames; monocular: the pair's first frame and the frames
+  // between), oldest first, T_world_camera. They had no pose when they were processed.
+  std::vector<StampedPose> earlier_frames;
   // Tracking was lost while the map was this young (MapInitializer::restart_when_lost_below):
   // the caller stops local mapping's work and calls Tracker::restart().
   bool restart_due = false;

@@ -15,11 +15,13 @@ namespace pspslam {
 
 // The per-frame files of a run, written (and flushed) as frames come, so an interrupted run
 // leaves valid files:
-//   trajectory.txt   T_world_camera of every tracked frame (TUM)
+//   trajectory.txt   T_world_camera of every tracked frame (TUM), and of the frames a monocular
+//                    map placed when it started (write_earlier)
 //   lost_frames.txt  frames without a pose (not initialised yet or lost): index timestamp state;
 //                    state `restarted` for frames tracked in a monocular map that was restarted
-//   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
-//                    dynamic-scene stages (mask age, geometry time, masked keypoints) and,
+//   timing.csv       per frame, as it was processed (a frame placed later keeps its
+//                    not_initialized row): extraction / tracking / local BA milliseconds, state,
+//                    the dynamic-scene stages (mask age, geometry time, masked keypoints) and,
 //                    for frames that arrived live (--realtime, a camera), arrival to pose
 class FrameLog {
  public:

@@ -715,11 +715,19 @@ TEST(CliRun, MonocularLoopIsClosedWithASimilarity) {
   EXPECT_LT(resized, 1.25);
   EXPECT_NE(resized, 1.0) << "a monocular loop must estimate its scale";
   EXPECT_GE(stats["monocular"]["tracked_since_initialisation"].get<int>(), 470) << run.output;
-  // The run must gain from loop closing: without it this sequence ends at 12.2 mm (deterministic).
-  // With it the final ATE depends on thread timing (which frames are tracked between the
-  // correction and the global BA's write-back): 6.4-9.9 mm in 13 runs at load 1-8, 11.0 mm once
-  // under ctest -j2 (docs/benchmarks.md, "Monocular loops: the loop's similarity refined").
-  EXPECT_LT(stats["ate_refined"]["rmse"].get<double>(), 0.012) << run.output;
+  // The run must gain from loop closing where loop closing acts, on the keyframes: without it
+  // they end at 12.6 mm (deterministic), with it at 4.7-5.4 mm in 7 runs, one of them under
+  // ctest -j2 (Sim(3), keyframes.txt). The final trajectory's frames between keyframes also
+  // depend on thread timing (which frames are tracked between the correction and the global BA's
+  // write-back, frames ~320-400): 6.4-9.9 mm in 19 runs at load 1-8, 11.0 and 15.8 mm once each
+  // under ctest -j2, against 12.3 mm without loop closing (docs/benchmarks.md, "Monocular loops:
+  // the loop's similarity refined"), so it is only held to "not broken".
+  AteOptions sim3;
+  sim3.sim3 = true;
+  const AteResult keyframes = compute_ate(read_tum_trajectory(dir / "seq" / "groundtruth.txt"),
+                                          read_tum_trajectory(out / "keyframes.txt"), sim3);
+  EXPECT_LT(keyframes.error.rmse, 0.008) << run.output;
+  EXPECT_LT(stats["ate_refined"]["rmse"].get<double>(), 0.020) << run.output;
 
   const auto localised = dir / "localised";
   const Result again = pspslam("run --sequence " + (dir / "seq").string() +

@@ -8,7 +8,7 @@ positions associated within 0.02 s):
            the placed frames' error there includes the map's scale drift at its start
   local  - aligned on the placed frames and the next 30 tracked frames: how well the placed frames
            agree with the map around them, next to those 30 tracked frames
-Numpy only.
+Numpy and bench/tum_numpy.py only.
 
     /usr/bin/python3 bench/placed_frames_error.py SEQ/groundtruth.txt OUT/trajectory.txt PLACED
 """
@@ -16,27 +16,7 @@ import argparse
 
 import numpy as np
 
-
-def load(path):
-    poses = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        values = line.split()
-        poses[float(values[0])] = np.array([float(x) for x in values[1:4]])
-    return poses
-
-
-def umeyama(source, target):
-    mu_s, mu_t = source.mean(0), target.mean(0)
-    s, t = source - mu_s, target - mu_t
-    u, sigma, vt = np.linalg.svd(t.T @ s / len(source))
-    d = np.eye(3)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
-        d[2, 2] = -1
-    rotation = u @ d @ vt
-    scale = np.trace(np.diag(sigma) @ d) / ((s ** 2).sum() / len(source))
-    return scale, rotation, mu_t - scale * rotation @ mu_s
+from tum_numpy import load_positions, umeyama
 
 
 def rms(errors):
@@ -49,7 +29,7 @@ def main():
     parser.add_argument("trajectory")
     parser.add_argument("placed", type=int, help="how many leading poses the map placed")
     args = parser.parse_args()
-    truth, estimate = load(args.groundtruth), load(args.trajectory)
+    truth, estimate = load_positions(args.groundtruth), load_positions(args.trajectory)
     truth_times = np.array(sorted(truth))
     pairs = []
     for index, time in enumerate(sorted(estimate)):
@@ -62,7 +42,8 @@ def main():
         raise SystemExit(f"need placed frames and 30 tracked ones: {len(placed)}, {len(tracked)}")
 
     def errors(subset, fit):
-        scale, rotation, offset = umeyama(np.array([p[1] for p in fit]), np.array([p[2] for p in fit]))
+        scale, rotation, offset = umeyama(np.array([p[1] for p in fit]), np.array([p[2] for p in fit]),
+                                          with_scale=True)
         return [float(np.linalg.norm(scale * rotation @ p[1] + offset - p[2])) for p in subset]
 
     global_placed, global_tracked = errors(placed, tracked), errors(tracked, tracked)

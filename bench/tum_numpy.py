@@ -1,5 +1,6 @@
 """Small numpy helpers shared by the bench scripts that read TUM trajectories themselves
-(common_frames_ate.py, loop_keyframe_states.py, rolling_shutter_rate_slope.py). Scripts that must
+(common_frames_ate.py, keyframe_error_split.py, loop_keyframe_states.py, placed_frames_error.py,
+rolling_shutter_rate_slope.py). Scripts that must
 stay independent of our code and of each other (independent_ate.py) do not use it.
 Needs Debian's python3-numpy (run the scripts with /usr/bin/python3)."""
 import numpy as np

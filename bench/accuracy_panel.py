@@ -32,8 +32,9 @@ the spread nowhere.
 Per cell and file (trajectory.txt = online, trajectory_refined.txt = final) the ATE RMSE (SE(3),
 Sim(3) for a monocular run; `pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
 to the ground truth than the online poses of the same frames. Writes WORK/panel.md and
-WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes (delete WORK, or
-give another, after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no
+WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes; each run's
+job.json records the binary's SHA-256, the sequence, config and flags, and a run made by anything
+else stops the panel with the folder named (delete it, or give another WORK, after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no
 table); --reuse-base WORK links those runs of another WORK (same baseline build, flags and cells)
 into this one instead of running them again, so a variant costs a third of the runs. Runs are
 deterministic (a variant identical to the baseline gives byte-identical trajectories where no loop
@@ -42,6 +43,7 @@ standard library.
 """
 import argparse
 import concurrent.futures
+import hashlib
 import json
 import os
 import re
@@ -210,9 +212,44 @@ def poses_at_stamps(trajectory, stamps_file, target):
     target.write_text("\n".join(rows) + "\n")
 
 
-def run_one(job):
+def file_sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def job_identity(job, cli_sha256):
+    """What makes a run what it is: the binary, the sequence, the config and the flags (not the
+    output folder, so that a baseline linked from another WORK is recognised)."""
+    _, cell, config_text, flags, _, mode = job
+    return {"pspslam_sha256": cli_sha256, "sequence": str(cell.sequence),
+            "config_sha256": hashlib.sha256(config_text.encode()).hexdigest(),
+            "dynamic": mode, "flags": flags}
+
+
+def check_reusable(job, identity):
+    """A run already in WORK is reused only when the same binary made it with the same sequence,
+    config and flags; anything else (a rebuild, an old WORK, a baseline linked from a WORK of
+    another build) stops the panel instead of being compared as if it were this invocation's."""
+    out = job[4]
+    if not (out / "stats.json").exists():
+        return None
+    recorded = out / "job.json"
+    if not recorded.exists():
+        return f"{out} holds a run without job.json (made by an older panel)"
+    differs = [key for key, value in identity.items()
+               if json.loads(recorded.read_text()).get(key) != value]
+    if differs:
+        return f"{out} holds a run of another {' / '.join(differs)}"
+    return None
+
+
+def run_one(job, identity):
     """One `pspslam run` of a cell by one variant (or the baseline's spread run); skipped when
-    its stats.json exists. Returns the measurements of every evaluation stretch."""
+    its stats.json exists (checked by check_reusable first). Returns the measurements of every
+    evaluation stretch."""
     cli, cell, config_text, flags, out, mode = job
     stats = out / "stats.json"
     if not stats.exists():
@@ -230,6 +267,7 @@ def run_one(job):
         run_stats = json.loads((out / "run" / "stats.json").read_text())
         run_stats["panel_wall_s"] = time.time() - started
         stats.write_text(json.dumps(run_stats))
+        (out / "job.json").write_text(json.dumps(identity, indent=1))
         log(f"{out.relative_to(out.parents[2])}: {run_stats['panel_wall_s']:.0f} s")
     run_stats = json.loads(stats.read_text())
     run = out / "run"
@@ -406,7 +444,7 @@ def main():
                 if (source / "stats.json").exists() and not target.exists():
                     target.parent.mkdir(parents=True, exist_ok=True)
                     target.symlink_to(source, target_is_directory=True)
-                if target.is_symlink():
+                if target.is_symlink() and target.resolve() == source:
                     linked += 1
     jobs, keys = [], []
     for cell in cells:
@@ -424,11 +462,18 @@ def main():
             jobs.append((clis["base"], cell, jittered, shlex.split(args.base_flags),
                          work / "runs" / cell.name / "spread", args.mode))
             keys.append(("spread", cell))
+    hashes = {cli: file_sha256(cli) for cli in set(clis.values())}
+    identities = [job_identity(job, hashes[job[0]]) for job in jobs]
+    stale = [problem for job, identity in zip(jobs, identities)
+             if (problem := check_reusable(job, identity))]
+    if stale:
+        sys.exit(f"accuracy_panel.py: {stale[0]} ({len(stale)} such runs); delete them or give "
+                 "another --work (or --reuse-base a WORK of this baseline)")
     log(f"{len(jobs)} runs of {len(cells)} cells in {work} ({args.jobs} at a time)")
     started = time.time()
     results = {"base": {}, "variant": {}, "spread": {}}
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for (label, _), measured in zip(keys, pool.map(run_one, jobs)):
+        for (label, _), measured in zip(keys, pool.map(run_one, jobs, identities)):
             results[label].update(measured)
     if args.base_only:
         log(f"baseline and spread runs done in {work}")

@@ -213,7 +213,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
                              !flags.semantic_masks.empty());
   dynamic.semantic_masks = flags.semantic_masks;
   system.local_mapping = !flags.no_local_mapping;
-  system.synchronous_local_mapping = !flags.realtime;
+  system.synchronous_back_end = !flags.realtime;
   const bool live = flags.realtime || !flags.camera.empty();
   system.background_thread_nice =
       flags.background_nice >= 0 ? flags.background_nice : (live ? kLiveBackgroundNice : 0);

@@ -28,7 +28,7 @@ SynthOptions rolling_shutter_room() {
 double online_ate(const SyntheticScene& scene, const SystemConfig& config) {
   SystemOptions options;
   options.place.loop_closing = false;
-  options.synchronous_back_end = true;
+  options.back_end_wait = BackEndWait::whole_back_end;
   System system(config, options);
   Trajectory estimate;
   SynthFrame rendered;

@@ -52,7 +52,7 @@ TEST(Stereo, TracksAShortStaticSyntheticPairSequenceWithinOneCentimetre) {
   ASSERT_EQ(config.camera.type, SensorType::stereo);
   SystemOptions options;
   options.place.loop_closing = false;
-  options.synchronous_back_end = true;
+  options.back_end_wait = BackEndWait::whole_back_end;
   System system(config, options);
   Trajectory estimate;
   SynthFrame rendered;
@@ -77,7 +77,7 @@ TEST(Stereo, GeometryMaskStaysOnThePeople) {
   const SyntheticScene scene(stereo_room(120, 3));
   SystemOptions options;
   options.place.loop_closing = false;
-  options.synchronous_back_end = true;
+  options.back_end_wait = BackEndWait::whole_back_end;
   options.dynamic.mode = DynamicMode::geometry;
   System system(scene.system_config(), options);
   SynthFrame rendered;
@@ -117,7 +117,7 @@ TEST(Stereo, FramesPreparedAheadGiveTheSameTrajectory) {
   const auto run = [&](bool ahead) {
     SystemOptions options;
     options.place.loop_closing = false;
-    options.synchronous_back_end = true;
+    options.back_end_wait = BackEndWait::whole_back_end;
     options.dynamic.mode = DynamicMode::geometry;  // the dense depth is used too
     System system(scene.system_config(), options);
     std::vector<Pose> poses;

@@ -73,7 +73,7 @@ TEST(System, KeypointFatesAreOptInAndAccountForEveryKeypoint) {
   const SyntheticScene scene(synth);
   const auto run = [&](bool record, std::vector<FrameReport>& reports) {
     SystemOptions options;
-    options.synchronous_back_end = true;
+    options.back_end_wait = BackEndWait::whole_back_end;
     options.place.relocalization = false;
     options.place.loop_closing = false;
     options.dynamic.mode = DynamicMode::geometry;

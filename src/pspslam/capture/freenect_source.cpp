@@ -157,6 +157,8 @@ class FreenectSource final : public FrameSource {
             .end_reason = end_reason_};
   }
 
+  bool live() const override { return true; }
+
  private:
   static FreenectSource& of(freenect_device* device) {
     return *static_cast<FreenectSource*>(freenect_get_user(device));

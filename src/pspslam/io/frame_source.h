@@ -43,6 +43,10 @@ class FrameSource {
   virtual const std::optional<Trajectory>& ground_truth() const = 0;
 
   virtual FrameSourceStats stats() const = 0;
+
+  // A camera: frames arrive whether or not the run is ready for them (the driver keeps the
+  // newest), so the run must not stall on seconds of background work.
+  virtual bool live() const { return false; }
 };
 
 }  // namespace pspslam

@@ -86,6 +86,7 @@ class VideoSource final : public FrameSource {
 
   const std::optional<Trajectory>& ground_truth() const override { return no_ground_truth_; }
   FrameSourceStats stats() const override { return {}; }
+  bool live() const override { return camera_; }
 
  private:
   std::string spec_;

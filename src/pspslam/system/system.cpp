@@ -200,7 +200,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     mapping_options.max_local_keyframes = options.local_ba_keyframes;
     // The BA's wall-clock budget keeps a live system responsive; a synchronous run bounds BA by
     // its iteration counts only, so its result does not depend on the machine's load.
-    if (options.synchronous_back_end)
+    if (options.back_end_wait != BackEndWait::none)
       mapping_options.bundle_adjustment.max_seconds = std::numeric_limits<double>::infinity();
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
       mapping_options.bundle_adjustment.depth_noise = {.enabled = true,
@@ -228,7 +228,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     }
     tracker_->start_in_loaded_map();
   }
-  synchronous_back_end_ = options.synchronous_back_end;
+  back_end_wait_ = options.back_end_wait;
   record_keypoint_fates_ = options.record_keypoint_fates;
   if (options.place.loop_closing && place_ && mapping_->local_mapping() != nullptr) {
     LoopClosingOptions loop_options;
@@ -274,7 +274,7 @@ FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
   report.extraction_ms = milliseconds_since(start);
   const double cpu_tracking_start = thread_cpu_ms();
   report.extraction_cpu_ms = cpu_tracking_start - cpu_start;
-  wait_for_back_end_if_synchronous();
+  wait_for_back_end();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
   if (report.tracking.restart_due) restart_map();
@@ -333,7 +333,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   report.extraction_ms += milliseconds_since(frame_start);
   report.extraction_cpu_ms = thread_cpu_ms() - cpu_start;  // includes flow and geometry
 
-  wait_for_back_end_if_synchronous();
+  wait_for_back_end();
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
   report.tracking = tracker_->track(std::move(tracked_frame));
@@ -344,7 +344,7 @@ FrameReport System::process(const RgbdFrame& frame) {
   // local mapping and loop closing refine: a deterministic run lets them finish this frame's
   // keyframe first, or the result would depend on thread timing (bonn `exhaustive` varied
   // 0.0183-0.0199 m run to run; a monocular loop's final file 6.4-15.8 mm).
-  wait_for_back_end_if_synchronous();
+  wait_for_back_end();
   dynamic_->end_frame(report.tracking, depth, semantic_mask, report.dynamic);
   if (fates) record_fates_of_tracked_frame(*fates);
   return report;
@@ -388,10 +388,10 @@ void System::restart_map() {
   tracker_->restart();
 }
 
-void System::wait_for_back_end_if_synchronous() {
-  if (!synchronous_back_end_) return;
+void System::wait_for_back_end() {
+  if (back_end_wait_ == BackEndWait::none) return;
   mapping_->wait_until_idle();
-  if (loop_closing_) {
+  if (back_end_wait_ == BackEndWait::whole_back_end && loop_closing_) {
     // Loop closing gets each keyframe after local mapping; a correction pauses local mapping
     // and the global BA runs after it, so mapping is waited for once more.
     loop_closing_->wait_until_idle();

@@ -42,19 +42,23 @@ struct PlaceOptions {
   bool needs_vocabulary() const { return relocalization || loop_closing; }
 };
 
+enum class BackEndWait { none, local_mapping, whole_back_end };
+
 struct SystemOptions {
   // ORB-SLAM2's virtual stereo baseline for RGB-D (u_r = u - fx * b / z), metres.
   double virtual_baseline = 0.08;
   TrackerOptions tracker;
   // false: keyframes go into the map but no local mapping runs (tests, debugging).
   bool local_mapping = true;
-  // true: a frame is tracked only once local mapping has finished the keyframes before it, loop
-  // closing has looked at them and any loop correction and global BA are applied (extraction
-  // still overlaps). Offline accuracy runs want this: without it the map a frame is tracked
-  // against, and whether a keyframe is accepted, depend on how fast this machine is right now (a
-  // fast, unpaced run outruns local BA; frames tracked between a loop correction and its global
-  // BA's write-back land centimetres off). A live camera wants false.
-  bool synchronous_back_end = false;
+  // What each frame waits for before it is tracked (extraction still overlaps).
+  // whole_back_end: local mapping has finished the keyframes before it, loop closing has looked
+  // at them and any loop correction and global BA are applied. Offline accuracy runs want this:
+  // otherwise the map a frame is tracked against, and whether a keyframe is accepted, depend on
+  // how fast this machine is right now (a fast, unpaced run outruns local BA; frames tracked
+  // between a loop correction and its global BA's write-back land centimetres off).
+  // local_mapping: only local mapping (a camera fed at its own pace: a global BA takes seconds,
+  // during which its driver would drop frames). none: a real-time feed never waits.
+  BackEndWait back_end_wait = BackEndWait::none;
   // Local BA window size (LocalMappingOptions::max_local_keyframes; 0: every covisible one).
   int local_ba_keyframes = 0;
   // Nice increment of the semantic, local mapping and loop closing threads (and of the global
@@ -181,7 +185,8 @@ class System {
  private:
   class MappingConnection;
 
-  void wait_for_back_end_if_synchronous();
+  // SystemOptions::back_end_wait.
+  void wait_for_back_end();
   // TrackResult::restart_due: local mapping finishes, the map and the keyframe database are
   // emptied and the tracker starts a new map with the next frames.
   void restart_map();
@@ -209,7 +214,7 @@ class System {
   std::uint64_t map_corrections_ = 0;
   std::uint64_t map_corrections_seen_ = 0;
   std::uint64_t next_frame_id_ = 0;
-  bool synchronous_back_end_ = false;
+  BackEndWait back_end_wait_ = BackEndWait::none;
   bool record_keypoint_fates_ = false;
   bool record_masked_fates_ = true;  // with record_keypoint_fates_: the second extraction too
   OrbFeatures unmasked_features_;    // record_keypoint_fates only: reused every frame

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     options.dynamic.model = std::filesystem::path(PSPSLAM_DATA) / "models/pspnet/pspnet.yaml";
     options.place.relocalization = false;
     options.place.loop_closing = false;
-    options.synchronous_back_end = true;
+    options.back_end_wait = pspslam::BackEndWait::whole_back_end;
     pspslam::System system(setup.config, options);
     size_t tracked = 0, masked = 0;
     for (size_t i = 0; i < setup.sequence.size(); ++i) {

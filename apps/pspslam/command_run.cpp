@@ -363,9 +363,10 @@ Command add_run_command(CLI::App& root) {
                   "segmentation metadata YAML (default: the shipped models/pspnet/pspnet.yaml)");
   app->add_flag("--realtime", flags->realtime,
                 "feed frames at the sequence's rate (late frames are dropped) and never wait for "
-                "segmentation or local mapping: use the newest mask, warped into the frame "
-                "(default: deterministic, each frame waits for its mask and for local mapping "
-                "to finish the previous keyframe)");
+                "segmentation or the back end: use the newest mask, warped into the frame "
+                "(default: deterministic, each frame waits for its mask and for local mapping, "
+                "loop closing and any global BA to finish the previous keyframe; a camera waits "
+                "for local mapping only)");
   app->add_option("--preload", flags->preload,
                   "with --realtime on a recording: on = decode every frame before the replay "
                   "starts, so that no image decoding shares the cores with the run (a camera "

@@ -30,16 +30,17 @@ spread has not lost. A variant is worth adopting when it wins on most cells and 
 the spread nowhere.
 
 Per cell and file (trajectory.txt = online, trajectory_refined.txt = final) the ATE RMSE (SE(3),
-Sim(3) for a monocular run; `pspslam eval`), the tracked frames, and whether the keyframes after BA (keyframes.txt) are closer
-to the ground truth than the online poses of the same frames. Writes WORK/panel.md and
-WORK/panel.json; existing runs in WORK are reused, so an interrupted panel resumes; each run's
-job.json records the binary's SHA-256, the sequence, config and flags, and a run made by anything
-else stops the panel with the folder named (delete it, or give another WORK, after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no
-table); --reuse-base WORK links those runs of another WORK (same baseline build, flags and cells)
-into this one instead of running them again, so a variant costs a third of the runs. Runs are
-deterministic (a variant identical to the baseline gives byte-identical trajectories where no loop
-closes), so a linked baseline is the baseline this invocation would have run. Needs only the Python
-standard library.
+Sim(3) for a monocular run; `pspslam eval`), the tracked frames, and whether the keyframes after
+BA (keyframes.txt) are closer to the ground truth than the online poses of the same frames. Writes
+WORK/panel.md and WORK/panel.json; existing runs in WORK are reused, so an interrupted panel
+resumes; each run's job.json records the binary's SHA-256, the sequence, config and flags, and a
+run made by anything else stops the panel with the folder named (delete it, or give another WORK,
+after a rebuild). --base-only runs the baseline and spread runs alone (no variant, no table);
+--reuse-base WORK links those runs of another WORK (same baseline build, flags and cells) into
+this one instead of running them again, so a variant costs a third of the runs. Runs are
+deterministic (a variant identical to the baseline gives byte-identical trajectories; since the
+fifteenth session also where a loop closes), so a linked baseline is the baseline this invocation
+would have run. Needs only the Python standard library.
 """
 import argparse
 import concurrent.futures

@@ -243,7 +243,7 @@ def check_reusable(job, identity):
     differs = [key for key, value in identity.items()
                if json.loads(recorded.read_text()).get(key) != value]
     if differs:
-        return f"{out} holds a run of another {' / '.join(differs)}"
+        return f"{out} holds a run that differs in {' / '.join(differs)}"
     return None
 
 

@@ -240,8 +240,8 @@ def check_reusable(job, identity):
     recorded = out / "job.json"
     if not recorded.exists():
         return f"{out} holds a run without job.json (made by an older panel)"
-    differs = [key for key, value in identity.items()
-               if json.loads(recorded.read_text()).get(key) != value]
+    made = json.loads(recorded.read_text())
+    differs = [key for key, value in identity.items() if made.get(key) != value]
     if differs:
         return f"{out} holds a run that differs in {' / '.join(differs)}"
     return None

@@ -213,7 +213,6 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
                              !flags.semantic_masks.empty());
   dynamic.semantic_masks = flags.semantic_masks;
   system.local_mapping = !flags.no_local_mapping;
-  system.back_end_wait = flags.realtime ? BackEndWait::none : BackEndWait::whole_back_end;
   const bool live = flags.realtime || !flags.camera.empty();
   system.background_thread_nice =
       flags.background_nice >= 0 ? flags.background_nice : (live ? kLiveBackgroundNice : 0);
@@ -266,8 +265,9 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   }
   // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
   // second of frames, so a live run without --realtime waits for local mapping only.
-  if (camera && camera->source->live() && system.back_end_wait == BackEndWait::whole_back_end)
-    system.back_end_wait = BackEndWait::local_mapping;
+  system.back_end_wait = flags.realtime                     ? BackEndWait::none
+                         : camera && camera->source->live() ? BackEndWait::local_mapping
+                                                            : BackEndWait::whole_back_end;
   // The viewer binds its address before the model and the sequence load, so a port in use is
   // told at once; it outlives the runner, which only points to it.
   std::unique_ptr<LiveViewer> viewer;

@@ -224,8 +224,13 @@ def file_sha256(path):
 def job_identity(job, cli_sha256):
     """What makes a run what it is: the binary, the sequence, the config and the flags (not the
     output folder, so that a baseline linked from another WORK is recognised)."""
-    _, cell, config_text, flags, _, mode = job
-    return {"pspslam_sha256": cli_sha256, "sequence": str(cell.sequence),
+    _, cell, config_text, flags, out, mode = job
+    # A cell made inside WORK (a slice, a re-encoding, a synthetic sequence) is named relative to
+    # it: the same cell of another WORK is the same sequence.
+    work = out.parents[2]
+    sequence = (f"WORK/{cell.sequence.relative_to(work)}" if cell.sequence.is_relative_to(work)
+                else str(cell.sequence))
+    return {"pspslam_sha256": cli_sha256, "sequence": sequence,
             "config_sha256": hashlib.sha256(config_text.encode()).hexdigest(),
             "dynamic": mode, "flags": flags}
 

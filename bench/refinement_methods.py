@@ -10,6 +10,8 @@ ground-truth pose within 20 ms, as `pspslam eval`), per cell of WORK/runs/<cell>
   whole        every keyframe correction D = T_BA · T_tracked⁻¹ interpolated in time and applied
                whole (the final trajectory before this script's change; it reproduces the run's
                trajectory_refined.txt exactly when no loop closed: one map epoch)
+  centred      the same corrections, each turning about its keyframe's tracked camera centre, so
+               the interpolation does not depend on where the world origin lies
   g=0.25 ...   the same with fixed shares g of every correction (D^g: angle and translation × g)
   g=est        the share estimated from the corrections themselves, clamp(1 − σ²/var, 0, 1):
                σ² = mean |d_k+1 − d_k|² / 2 and var = mean |d_k − mean d|² over the keyframes'
@@ -96,6 +98,33 @@ def interpolate(online, corrections):
     return np.array(out)
 
 
+def interpolate_about_centres(online, corrections):
+    """As interpolate(), but each correction D_k turns about its keyframe's tracked camera centre
+    c_k (D_k: x -> R_k (x - c_k) + D_k c_k), so a frame between keyframes a and b is turned by
+    slerp(R_a, R_b) about the chord point (1 - s) c_a + s c_b, which then moves to
+    (1 - s) D_a c_a + s D_b c_b: the same at the keyframes, independent of where the world origin
+    lies in between (interpolate() blends D's translations, which carry R_k times the keyframe's
+    distance from the origin)."""
+    stamps = np.array([c[0] for c in corrections])
+    out = []
+    for row in online:
+        n = np.searchsorted(stamps, row[0] - 1e-9)
+        if n == 0 or n == len(stamps):
+            d = corrections[0 if n == 0 else -1][1]
+            out.append(row_of(row[0], d @ matrix(row)))
+            continue
+        (ta, a, ca), (tb, b, cb) = corrections[n - 1], corrections[n]
+        s = (row[0] - ta) / (tb - ta)
+        r = a[:3, :3] @ exp_so3(s * log_so3(a[:3, :3].T @ b[:3, :3]))
+        chord = (1 - s) * ca + s * cb
+        moved = (1 - s) * (a[:3, :3] @ ca + a[:3, 3]) + s * (b[:3, :3] @ cb + b[:3, 3])
+        pose = matrix(row)
+        pose[:3, :3] = r @ pose[:3, :3]
+        pose[:3, 3] = r @ (pose[:3, 3] - chord) + moved
+        out.append(row_of(row[0], pose))
+    return np.array(out)
+
+
 def estimated_gain(online, keyframes):
     shifts = np.array([row[1:4] - online[i, 1:4] for i, row in keyframe_indices(online,
                                                                                    keyframes)])
@@ -123,7 +152,9 @@ def local_fit(online, i, half):
 def methods(online, keyframes):
     pairs = keyframe_indices(online, keyframes)
     corrections = [(row[0], matrix(row) @ np.linalg.inv(matrix(online[i]))) for i, row in pairs]
-    out = {"online": online, "whole": interpolate(online, corrections)}
+    out = {"online": online, "whole": interpolate(online, corrections),
+           "centred": interpolate_about_centres(
+               online, [(t, d, online[i, 1:4]) for (t, d), (i, _) in zip(corrections, pairs)])}
     for g in (0.25, 0.5, 0.75):
         out[f"g={g}"] = interpolate(online, [(t, power(d, g)) for t, d in corrections])
     g = estimated_gain(online, keyframes)

@@ -79,9 +79,15 @@ def keyframe_indices(online, keyframes):
     return [(index[round(row[0], 4)], row) for row in keyframes if round(row[0], 4) in index]
 
 
-def interpolate(online, corrections):
+def interpolate(online, corrections, centres=None):
     """corrections: [(stamp, D)] sorted; D interpolated in time (slerp, linear), applied on the
-    left; ends take the nearest keyframe's D (src/pspslam/tracking/trajectory_refinement.cpp)."""
+    left; ends take the nearest keyframe's D (src/pspslam/tracking/trajectory_refinement.cpp).
+    centres: the keyframes' tracked camera centres c_k; then each D_k turns about c_k
+    (x -> R_k (x - c_k) + D_k c_k), so a frame between keyframes a and b is turned by
+    slerp(R_a, R_b) about the chord point (1 - s) c_a + s c_b, which moves to
+    (1 - s) D_a c_a + s D_b c_b: the same at the keyframes, and independent of where the world
+    origin lies in between (blending D's translations carries R_k times the keyframe's distance
+    from the origin)."""
     stamps = np.array([c[0] for c in corrections])
     out = []
     for row in online:
@@ -94,34 +100,11 @@ def interpolate(online, corrections):
             d = np.eye(4)
             d[:3, :3] = a[:3, :3] @ exp_so3(s * log_so3(a[:3, :3].T @ b[:3, :3]))
             d[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
+            if centres is not None:
+                ca, cb = centres[n - 1], centres[n]
+                moved = (1 - s) * (a[:3, :3] @ ca + a[:3, 3]) + s * (b[:3, :3] @ cb + b[:3, 3])
+                d[:3, 3] = moved - d[:3, :3] @ ((1 - s) * ca + s * cb)
         out.append(row_of(row[0], d @ matrix(row)))
-    return np.array(out)
-
-
-def interpolate_about_centres(online, corrections):
-    """As interpolate(), but each correction D_k turns about its keyframe's tracked camera centre
-    c_k (D_k: x -> R_k (x - c_k) + D_k c_k), so a frame between keyframes a and b is turned by
-    slerp(R_a, R_b) about the chord point (1 - s) c_a + s c_b, which then moves to
-    (1 - s) D_a c_a + s D_b c_b: the same at the keyframes, independent of where the world origin
-    lies in between (interpolate() blends D's translations, which carry R_k times the keyframe's
-    distance from the origin)."""
-    stamps = np.array([c[0] for c in corrections])
-    out = []
-    for row in online:
-        n = np.searchsorted(stamps, row[0] - 1e-9)
-        if n == 0 or n == len(stamps):
-            d = corrections[0 if n == 0 else -1][1]
-            out.append(row_of(row[0], d @ matrix(row)))
-            continue
-        (ta, a, ca), (tb, b, cb) = corrections[n - 1], corrections[n]
-        s = (row[0] - ta) / (tb - ta)
-        r = a[:3, :3] @ exp_so3(s * log_so3(a[:3, :3].T @ b[:3, :3]))
-        chord = (1 - s) * ca + s * cb
-        moved = (1 - s) * (a[:3, :3] @ ca + a[:3, 3]) + s * (b[:3, :3] @ cb + b[:3, 3])
-        pose = matrix(row)
-        pose[:3, :3] = r @ pose[:3, :3]
-        pose[:3, 3] = r @ (pose[:3, 3] - chord) + moved
-        out.append(row_of(row[0], pose))
     return np.array(out)
 
 
@@ -153,8 +136,7 @@ def methods(online, keyframes):
     pairs = keyframe_indices(online, keyframes)
     corrections = [(row[0], matrix(row) @ np.linalg.inv(matrix(online[i]))) for i, row in pairs]
     out = {"online": online, "whole": interpolate(online, corrections),
-           "centred": interpolate_about_centres(
-               online, [(t, d, online[i, 1:4]) for (t, d), (i, _) in zip(corrections, pairs)])}
+           "centred": interpolate(online, corrections, [online[i, 1:4] for i, _ in pairs])}
     for g in (0.25, 0.5, 0.75):
         out[f"g={g}"] = interpolate(online, [(t, power(d, g)) for t, d in corrections])
     g = estimated_gain(online, keyframes)

@@ -28,7 +28,7 @@ struct KeyFramePolicyOptions {
   // 3.3 mm at the keyframes (docs/benchmarks.md, #15 item 5); with this on, 2.8-4.0 mm with loop
   // closing and 6.8-10.4 mm without on four loop sequences, against 5.1-7.2 and 13.8-20.1 mm. Off
   // by default: on the real clip it moves the final trajectory by tenths of a millimetre, more
-  // often up than down (6 of 9 dev cells worse, online unchanged), and one cell fewer has its
+  // often up than down (6 of 9 dev cells worse, online within 0.1 mm), and one cell fewer has its
   // keyframes after BA closer to the truth than online (docs/benchmarks.md, sixteenth session).
   // `pspslam run --due-keyframes` sets it.
   bool insert_when_due = false;

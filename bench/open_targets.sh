@@ -10,8 +10,9 @@
 #     deterministic, so one run per cell)
 #   4 #16 synthetic monocular `full` <= 15 mm, >= 98 % of the frames (the demo's sequence is
 #     seed 1 of bench/monocular_seeds.sh; the other eleven seeds beside it)
-# Each part writes its own folder under WORK and its script's own summary to WORK/PART.txt;
-# parts already complete in WORK are not run again (the scripts reuse their runs).
+# Each part writes its own folder under WORK and its script's own summary to WORK/PART.txt. A
+# second invocation on the same WORK reuses the panel's and the twins' runs and every rendered
+# sequence; the loop and mono parts run again (their scripts do not reuse runs).
 #   usage: bench/open_targets.sh [BUILD_DIR (default build)] [WORK (default /tmp/open_targets)]
 #          PARTS="panel twin loop mono" ...    a subset
 set -euo pipefail
@@ -51,9 +52,9 @@ part mono env VARIANT="$cli" WORK="$work/mono" PYTHON="$python_numpy" \
 
 # The lines each target is read from.
 echo
-[[ -f "$work/panel.txt" ]] && grep -E '^(- (paired|keyframes after BA|final trajectory not)|\| baseline .*dev-clip)' \
-  "$work/panel.txt" || true
+panel_lines='^(- (paired|keyframes after BA|final trajectory not)|\| baseline .*dev-clip)'
+[[ -f "$work/panel.txt" ]] && grep -E "$panel_lines" "$work/panel.txt" || true
 [[ -f "$work/twin.txt" ]] && grep -E 'within 1.3x|median ratio' "$work/twin.txt" || true
 [[ -f "$work/loop.txt" ]] && grep -E 'on/off refined' "$work/loop.txt" || true
-[[ -f "$work/mono.txt" ]] && grep -E '^1 variant' "$work/mono.txt" |
-  awk '{print "monocular demo sequence (seed 1): posed " $5 ", Sim(3) ATE online " $6 " / final " $7 " mm"}' || true
+[[ -f "$work/mono.txt" ]] && grep -E '^1 variant' "$work/mono.txt" | awk '{print "monocular demo \
+sequence (seed 1): posed " $5 ", Sim(3) ATE online " $6 " / final " $7 " mm"}' || true

@@ -56,5 +56,7 @@ panel_lines='^(- (paired|keyframes after BA|final trajectory not)|\| baseline .*
 [[ -f "$work/panel.txt" ]] && grep -E "$panel_lines" "$work/panel.txt" || true
 [[ -f "$work/twin.txt" ]] && grep -E 'within 1.3x|median ratio' "$work/twin.txt" || true
 [[ -f "$work/loop.txt" ]] && grep -E 'on/off refined' "$work/loop.txt" || true
-[[ -f "$work/mono.txt" ]] && grep -E '^1 variant' "$work/mono.txt" | awk '{print "monocular demo \
-sequence (seed 1): posed " $5 ", Sim(3) ATE online " $6 " / final " $7 " mm"}' || true
+if [[ -f "$work/mono.txt" ]] && read -r _ _ _ _ posed online final < <(grep -E '^1 variant' \
+  "$work/mono.txt"); then
+  echo "monocular demo sequence (seed 1): posed $posed, Sim(3) ATE online $online / final $final mm"
+fi

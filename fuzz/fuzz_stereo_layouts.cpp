@@ -1,6 +1,6 @@
-// The stereo layouts' text files (issue #16): the first byte picks which one the rest becomes,
-// written into an otherwise valid folder: KITTI times.txt, calib.txt or poses.txt, EuRoC
-// cam0/data.csv or cam1/sensor.yaml. Listed images do not exist (the missing-files path).
+// The stereo layouts' text files: the first byte picks which one the rest becomes, written into an
+// otherwise valid folder: KITTI times.txt, calib.txt or poses.txt, EuRoC cam0/data.csv or
+// cam1/sensor.yaml. Listed images do not exist (the missing-files path).
 #include "fuzz_input.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/trajectory_io.h"

@@ -59,8 +59,8 @@ Command add_synth_command(CLI::App& root) {
                   "recordings have it (depth noise ~z^2 quantised in disparity, holes, depth up to "
                   "+-16 ms off colour, rolling shutter, motion blur, exposure changes, lens "
                   "distortion, the Bonn clip's speeds, marker-body ground truth + "
-                  "body_to_camera.txt). The accuracy panel should use kinect: ideal errors are "
-                  "~3 mm, far below any real recording's")
+                  "body_to_camera.txt). Accuracy experiments should use kinect: ideal errors are "
+                  "far below any real recording's")
       ->check(CLI::IsMember({"ideal", "kinect"}))
       ->capture_default_str();
   std::string fault_list;

@@ -80,8 +80,7 @@ std::string command_list(const CLI::ParseError& error, const CLI::App* app) {
 
 void configure_logging(const std::string& level, bool quiet) {
   auto logger = spdlog::stderr_logger_st("pspslam");
-  // "warning: ...", "error: ...": the form the messages had before spdlog, which tests and users
-  // grep for.
+  // "warning: ...", "error: ...": the plain form that tests and users grep for.
   logger->set_pattern("%l: %v");
   logger->set_level(quiet ? spdlog::level::warn : spdlog::level::from_str(level));
   logger->flush_on(spdlog::level::trace);

@@ -240,8 +240,8 @@ TEST_F(Fakenect, UnpluggedMidRunEndsWithStatusFourAndEveryOutput) {
 // At the device's rate a run that cannot keep up never holds the driver back: the newest frames
 // win, and every captured frame is either processed or counted as dropped (summary and
 // stats.json). The replay's end is then the camera going away: status 4.
-// (Deterministic `full` waits for each PSPNet mask, slower than 30 frames/s on the 2-core
-// development machine, so frames are dropped there.)
+// (Deterministic `full` waits for each PSPNet mask, which on a small CPU takes longer than a
+// frame interval, so frames are dropped there.)
 TEST_F(Fakenect, RunAtThirtyHertzCountsEveryDroppedFrame) {
   make_sequence_and_dumps();
   const Result run =

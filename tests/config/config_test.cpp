@@ -153,7 +153,7 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
   EXPECT_EQ(config.camera.depth_noise, CameraConfig::DepthNoise::none);
 }
 
-// Stereo (issue #16): type, baseline or bf, the depth-image keys refused, monocular "not yet".
+// Stereo: type, baseline or bf, the depth-image keys refused, monocular "not yet".
 constexpr const char* kStereoCamera =
     "camera:\n"
     "  name: pair\n"
@@ -215,8 +215,7 @@ TEST(Config, StereoErrorsNameFileLineAndKey) {
                                   "'camera.baseline'?)");
 }
 
-// Monocular (issue #16): intrinsics and fps only; depth and baseline keys are named as another
-// sensor's.
+// Monocular: intrinsics and fps only; depth and baseline keys are named as another sensor's.
 TEST(Config, MonocularCameraRoundTripsAndRefusesDepthAndBaselineKeys) {
   const auto dir = testing::make_temp_dir("config_monocular");
   const std::string monocular = replace(

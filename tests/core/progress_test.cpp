@@ -16,8 +16,8 @@ std::vector<std::string> lines_of(const std::string& text) {
   return lines;
 }
 
-// Issue #20: a real-time run of 150 frames that processed 90 and dropped 60 ends at "150/150",
-// not at "90/150", and says how many frames were processed and dropped.
+// A real-time run of 150 frames that processed 90 and dropped 60 ends at "150/150", not at
+// "90/150", and says how many frames were processed and dropped.
 TEST(ProgressBar, RealtimeFeedCountsFramesFedProcessedAndDropped) {
   std::ostringstream out;  // not a terminal: one plain line per tenth of the frames fed
   ProgressBar bar("slam", 150, out, true, true);

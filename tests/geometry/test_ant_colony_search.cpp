@@ -94,7 +94,7 @@ TEST(AntColonySearch, FindsEveryPlantedClusterTestingFewerPoints) {
       // Sparse discs have gaps near the band width, so a few rim points may stay untested.
       EXPECT_GE(found, (density == Density::sparse ? 0.9 : 0.97) * planted) << where;
       // Static points tested = the path's share (~25 %) plus the 80 px bands around three
-      // people (each band ~ a quarter of the image): measured 0.42-0.59 of the background.
+      // people (each band ~ a quarter of the image): about half of the background.
       const int background = static_cast<int>(set.points.size()) - planted;
       EXPECT_LT(r.tested_count - found, 0.65 * background) << where;
       EXPECT_EQ(r.dynamic_count, found);

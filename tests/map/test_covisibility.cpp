@@ -133,7 +133,7 @@ TEST_F(CovisibilityTest, ReplacingAPointMovesObservations) {
 }
 
 // A point that loses its second observation turns bad inside MapPoint::erase_observation; nothing
-// on that path can reach the Map, so the Map must sweep it (issue #3 loose end (a)).
+// on that path can reach the Map, so the Map must sweep it.
 TEST_F(CovisibilityTest, PointsThatTurnBadAreSweptFromTheMap) {
   auto kf0 = make_keyframe(0);
   auto kf1 = make_keyframe(10);
@@ -151,7 +151,7 @@ TEST_F(CovisibilityTest, PointsThatTurnBadAreSweptFromTheMap) {
 }
 
 // A close point near the left border has a negative virtual right coordinate u − bf/z; it still
-// has depth (issue #3 loose end (c): "right_u < 0" used to mean "no depth").
+// has depth: "no depth" is a NaN right coordinate, not a negative one.
 TEST_F(CovisibilityTest, NegativeRightCoordinateStillCountsAsDepth) {
   const std::vector<cv::KeyPoint> keypoints = {cv::KeyPoint(cv::Point2f(5.0f, 100.0f), 31.0f),
                                                cv::KeyPoint(cv::Point2f(300.0f, 100.0f), 31.0f)};

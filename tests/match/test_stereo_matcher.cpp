@@ -85,8 +85,8 @@ TEST(StereoMatcher, FindsAKnownSubPixelDisparity) {
   }
 }
 
-// Issue #16's criterion on a rendered pair: the synthetic room's right camera (synth/) against
-// the exact depth of the left one.
+// The stereo matcher's accuracy on a rendered pair: the synthetic room's right camera (synth/)
+// against the exact depth of the left one.
 TEST(StereoMatcher, RenderedPairDisparityWithinAQuarterPixel) {
   SynthOptions options;
   options.frames = 1;

@@ -42,9 +42,9 @@ void register_keyframe(Map& map, const std::shared_ptr<KeyFrame>& keyframe) {
 }
 
 // Five keyframes whose estimated poses (except the anchor) are off by 0.5° / 2 cm: global BA
-// must pull them back to the truth (measured: 20 mm -> 1.5 mm; 1 px keypoint noise), and a keyframe
-// added while it runs (a child of keyframe 4 in the spanning tree) must move along with its parent
-// when the result is applied.
+// must pull them back to the truth (with 1 px keypoint noise), and a keyframe added while it runs
+// (a child of keyframe 4 in the spanning tree) must move along with its parent when the result is
+// applied.
 TEST(GlobalBundleAdjustment, CorrectsPosesAndPropagatesToNewKeyframes) {
   SyntheticWorld world(1500, 0.0, 21);
   Map map;
@@ -99,10 +99,9 @@ TEST(GlobalBundleAdjustment, CorrectsPosesAndPropagatesToNewKeyframes) {
 
 // The global BA must weigh depth with the model it is given (System passes the camera's, the one
 // local BA uses). With it ignored, the u_r row (about 15x looser) lets keyframes slide along their
-// viewing direction: on the synthetic 1.5-turn loop two weakly connected keyframes ended 23-25 mm
-// off after the global BA (#15 item 5). Here the depth is exact and the keypoints carry 1 px
-// noise, so the sensor model must land the keyframes closer to the truth than the u_r row
-// (measured: RMS centre error 0.55 mm vs 0.96 mm; ignoring the option gives equal errors).
+// viewing direction, most of all weakly connected keyframes of a long loop. Here the depth is
+// exact and the keypoints carry 1 px noise, so the sensor model must land the keyframes closer to
+// the truth than the u_r row (ignoring the option gives equal errors).
 TEST(GlobalBundleAdjustment, UsesTheGivenDepthNoiseModel) {
   const auto solve_error = [](const GlobalBaOptions& options) {
     SyntheticWorld world(1500, 0.0, 21);

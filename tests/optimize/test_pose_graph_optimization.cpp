@@ -103,8 +103,8 @@ TEST(PoseGraphOptimization, DriftCorruptedLoopIsClosed) {
   EXPECT_LT(result.final_cost, 0.01 * result.initial_cost);
   EXPECT_GT(before, 0.1) << "the drift should be large before optimisation";
   // Biased odometry cannot be undone by one loop edge everywhere (the middle of the loop keeps
-  // part of the bent shape): the loop error is spread, the RMS error about halves (measured
-  // 0.203 -> 0.106 m) and the loop end, measured exactly by the loop edge, lands on the start.
+  // part of the bent shape): the loop error is spread, the RMS error about halves and the loop
+  // end, measured exactly by the loop edge, lands on the start.
   EXPECT_LT(after, 0.6 * before) << "before " << before << " m, after " << after << " m";
   EXPECT_GT(end_before, 0.1);
   EXPECT_LT(end_after, 0.02) << "the loop edge is exact: the end must land on the start";

@@ -203,7 +203,7 @@ TEST_F(MapFileTest, AnotherCameraIsRefused) {
   EXPECT_NE(error.find("made with fx = "), std::string::npos) << error;
 }
 
-// Issue #4: save -> load -> localise on the same sequence reproduces the trajectory within 1 cm.
+// Save -> load -> localise on the same sequence reproduces the trajectory within 1 cm.
 TEST_F(MapFileTest, LocalisationInTheLoadedMapReproducesTheTrajectory) {
   SystemOptions options;
   options.map_file = map_file();

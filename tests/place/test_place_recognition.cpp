@@ -136,7 +136,7 @@ TEST_F(LoopPlaceRecognition, ErasedKeyframeIsNeverReturned) {
 
 // The direct index narrows matching to descriptors under the same node (ORB-SLAM2's
 // SearchByBoW): how many good brute-force matches between two nearby frames survive that, per
-// level. Measured: 82% at level 1 (10 nodes), 65% at level 2 (100 nodes): the price of a
+// level. Most survive at level 1 (10 nodes), fewer at level 2 (100 nodes): the price of a
 // ~100x smaller search, which ORB-SLAM2 pays for relocalisation and loop closing.
 TEST(DirectIndex, KeepsMostGoodMatchesBetweenNearbyFrames) {
   const Vocabulary vocabulary = Vocabulary::load(shipped_vocabulary());

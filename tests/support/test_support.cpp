@@ -33,8 +33,8 @@ namespace {
 
 // Removes the folders make_temp_dir handed out once they are no longer needed: a test's own
 // folders when it ends without failing, a suite fixture's when the program ends without a failure.
-// A failed test keeps its folders and names them, so its outputs can be read. Before this, every
-// ctest run left its outputs in /tmp (a few hundred MB per run of the camera tests).
+// A failed test keeps its folders and names them, so its outputs can be read. Otherwise every
+// ctest run would leave its outputs in /tmp, which the camera tests fill quickly.
 class TempDirJanitor : public ::testing::EmptyTestEventListener {
  public:
   void add(const std::filesystem::path& dir, bool belongs_to_a_test) {

@@ -248,7 +248,7 @@ TEST(SynthKinect, SyncOffsetRendersDepthAtTheOffsetPose) {
 
 // The Bonn crowd clip's ground truth moves at a median 12.7 deg/s and 0.085 m/s frame to frame
 // (bench/trajectory_error_bands.py's loader on groundtruth.txt, 404 poses): the kinect hand-held
-// path matches both within 15 %; the ideal one turns a little faster and moves 2.3 x faster.
+// path matches both within 15 %; the ideal one turns a little faster and moves about twice as fast.
 TEST(SynthKinect, HandheldMotionHasTheBonnClipsSpeeds) {
   const auto speeds = [](const SynthOptions& options) {
     std::vector<double> rotation, translation;

@@ -27,7 +27,7 @@ std::string run(const std::string& arguments) {
   return output;
 }
 
-// Issue #20: `--load-map M --localization` on a sequence with people. The geometry stage tests
+// `--load-map M --localization` on a sequence with people. The geometry stage tests
 // points against views rebuilt from the map's keyframes, nothing in the run changes the map (the
 // map saved after the run is the loaded file, byte for byte), and the header says loop closing is
 // off.

@@ -69,10 +69,10 @@ TEST(Stereo, TracksAShortStaticSyntheticPairSequenceWithinOneCentimetre) {
 
 // The geometry stage on a stereo pair judges each keypoint by its own stereo depth, not by the
 // dense depth at its pixel: block matching lends a near surface's disparity to the farther pixels
-// next to a depth edge, where corners lie, and a static keypoint read that way lay in front of
-// what its reference keyframes saw, a false "moved". Measured on this sequence, 120 frames: the
-// geometry mask had 64 % of its pixels on people reading SGBM at the keypoints, 95 % (recall 38 %)
-// with the keypoints' own depths and StereoBM (docs/benchmarks.md, issue #16).
+// next to a depth edge, where corners lie, and a static keypoint read that way lies in front of
+// what its reference keyframes saw, a false "moved". Reading dense depth at the keypoints puts a
+// large share of the geometry mask on static pixels; the keypoints' own depths keep it on the
+// people (system/frame_builder.cpp).
 TEST(Stereo, GeometryMaskStaysOnThePeople) {
   const SyntheticScene scene(stereo_room(120, 3));
   SystemOptions options;

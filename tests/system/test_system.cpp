@@ -298,9 +298,8 @@ TEST(RunCommand, InterruptWritesTrajectoryAndStats) {
 
 // Geometry-only mode on the synthetic dynamic sequence of the benchmark (300 frames, 3 people,
 // one carrying a box, seed 1): the multi-view test must find the people and the run must stay
-// as accurate as on the static twin (measured 0.011 m both, bench/results/modes.csv). Plain
-// SLAM (`off`) is not compared here: whether it survives this sequence depends on the core's
-// outlier handling, which changed while this was written (0.235 m -> 0.006 m; see the report).
+// about as accurate as on the static twin. Plain SLAM (`off`) is not compared here: whether it
+// survives this sequence depends on the core's outlier handling, not on the dynamic pipeline.
 // Geometry-only keeps the segmentation network's run time out of the test. A second run must
 // reproduce the first trajectory exactly.
 TEST(RunCommand, GeometryModeFindsPeopleAndStaysAccurateOnADynamicSyntheticSequence) {

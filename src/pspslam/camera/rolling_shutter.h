@@ -11,10 +11,10 @@ namespace pspslam {
 // another: row v at t + readout_s * (v / rows - 1/2), so a frame's timestamp is its middle row's
 // instant (as synth/ renders it). Everything downstream of the Frame assumes one instant per
 // image; while the camera turns, a keypoint on row v was seen from another orientation, and a
-// 30 ms readout at the Bonn clip's 12 deg/s skews the image by ~3 px top to bottom.
-// On the synthetic Kinect sequences that skew was the largest single fault (5-9 mm of 8-13 mm
-// ATE), and the Bonn clip's camera reads its rows over ~30 ms too (docs/benchmarks.md, "Rolling
-// shutter").
+// 30 ms readout while a hand-held camera turns at 12 deg/s skews the image by ~3 px top to
+// bottom. On the synthetic Kinect sequences that skew is the largest single source of tracking
+// error, and real Kinect-class colour cameras read their rows over a similar time
+// (docs/decisions/rolling-shutter.md).
 //
 // The correction turns each keypoint's bearing by the camera's rotation between its row's
 // instant and the frame's: a static point seen at X_v from the camera at t_v is at

@@ -312,7 +312,7 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
   out << YAML::Key << "initial_fast_threshold" << YAML::Value << config.orb.initial_fast_threshold;
   out << YAML::Key << "min_fast_threshold" << YAML::Value << config.orb.min_fast_threshold;
   // Written only when switched on, so that sequences rendered by this build still load in
-  // builds that predate the key (the accuracy panel runs both on the same sequences).
+  // builds that predate the key (experiments compare builds on the same sequences).
   if (config.orb.mask_compensation) out << YAML::Key << "mask_compensation" << YAML::Value << true;
   out << YAML::EndMap;
   // Likewise only when it differs from the defaults.

@@ -62,10 +62,10 @@ struct OrbConfig {
   // When an extraction mask removes part of the image, keep the kept-keypoint count near
   // n_features: a pyramid level with fewer unmasked corners than its share is searched again at
   // min_fast_threshold, and what it still lacks goes to the levels that have corners to spare
-  // (ORB-SLAM2 has neither: a frame 70 % covered by people kept ~580 of 1000 keypoints). Frames
-  // without masked pixels are extracted exactly as before. YAML key `mask_compensation`. Off by
-  // default: on bonn_crowd_dev it keeps the count but makes every mode less accurate (why is
-  // not established; docs/benchmarks.md, issue #18 item 3).
+  // (ORB-SLAM2 has neither, so a frame mostly covered by people keeps far fewer keypoints than
+  // asked for). Frames without masked pixels are extracted exactly as with it off. YAML key
+  // `mask_compensation`. Off by default: on real crowded sequences it keeps the count but makes
+  // every mode less accurate, for reasons not established (docs/decisions/mask-compensation.md).
   bool mask_compensation = false;
 };
 

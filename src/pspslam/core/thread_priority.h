@@ -2,11 +2,11 @@
 
 namespace pspslam {
 
-// Lowers the scheduling priority of the calling thread only (Linux: the nice value of this
-// thread's id; other threads of the process keep theirs). Real-time runs use it so that the
-// network, local mapping and loop closing yield a core to the caller thread, which must track
-// each frame before the next arrives (issue #18). `increment` <= 0 changes nothing. Returns
-// false when the system refused (then the thread runs on at its old priority).
+// Lowers the scheduling priority of the calling thread only (Linux: the nice value of this thread's
+// id; other threads of the process keep theirs). Real-time runs use it so that the network, local
+// mapping and loop closing yield a core to the caller thread, which must track each frame before
+// the next arrives. `increment` <= 0 changes nothing. Returns false when the system refused (then
+// the thread runs on at its old priority).
 bool lower_this_thread_priority(int increment);
 
 // The calling thread's nice value (for tests and the run report).
@@ -14,10 +14,10 @@ int this_thread_nice();
 
 // Keeps BLAS/LAPACK calls on the calling thread. OpenCV and Ceres link the system BLAS, which on
 // Debian is OpenBLAS's pthread build: its workers spin on sched_yield after each call, and the
-// calls here are small (a few dozen rows), so on two cores the spinning took ~0.5 core from
-// tracking, local mapping and the network (bonn_crowd_dev `full`: 6.9 s of system time in a
-// 20 s run, 0.4 s with one BLAS thread). Found at run time (dlsym), so a BLAS without threads or
-// without OpenBLAS's entry point is left as it is. Returns true when OpenBLAS was told.
+// calls here are small (a few dozen rows), so on two cores the spinning takes a large share of a
+// core from tracking, local mapping and the network, as system time. Found at run time (dlsym), so
+// a BLAS without threads or without OpenBLAS's entry point is left as it is. Returns true when
+// OpenBLAS was told.
 bool use_single_threaded_blas();
 
 // OpenBLAS's thread count, or 0 when the BLAS in use is not OpenBLAS (for the run report).

@@ -40,8 +40,8 @@ std::vector<BriefPair> make_brief_candidates();
 
 // Steering makes plain G II bits strongly biased: after rotating every patch to its intensity
 // centroid, a pair whose second point lies further along the centroid direction is almost
-// always brighter. On bonn_crowd_dev the median bit was 1 with probability 0.5 +- 0.29 and
-// unrelated descriptors differed by only ~92 of 256 bits, which defeats the usual 50 / 100 bit
+// always brighter. On real images a typical bit is then far from balanced and unrelated
+// descriptors differ in well under half of their 256 bits, which defeats the usual 50 / 100 bit
 // matching thresholds. The ORB paper's remedy (rBRIEF) picks, from a large pool, tests whose
 // mean is near 0.5 and which are mutually uncorrelated; this is that selection:
 //
@@ -50,8 +50,8 @@ std::vector<BriefPair> make_brief_candidates();
 // with every kept one is below a threshold that starts at 0.2 and grows by 0.05 until `count`
 // are kept. Unlike the paper, candidates with |mean - 0.5| > max_bias are not visited at all
 // (used only if too few remain): otherwise the greedy pass, refusing correlated balanced tests,
-// fills up with strongly biased ones (measured on bonn_crowd_dev: unrelated descriptors then
-// differ by a median of 90 bits; with max_bias 0.15, 125 bits, 5th percentile 85).
+// fills up with strongly biased ones, and unrelated descriptors again differ in far fewer than
+// half of their bits; with max_bias they differ in close to half.
 // Constant tests (mean 0 or 1) have bias 0.5 and are thus never picked unless forced to.
 // Returns the kept candidate indices in selection order.
 std::vector<int> select_decorrelated_pairs(std::span<const std::vector<std::uint64_t>> outcomes,

@@ -189,11 +189,10 @@ void OrbExtractor::detect_candidates(int level, const cv::Mat& ignore_mask) {
   for (int row = 0; row < n_rows; ++row) {
     for (int col = 0; col < n_cols; ++col) {
       if (cell_counts_[static_cast<std::size_t>(row) * n_cols + col] > 0) continue;
-      // Cells left empty get a second pass at the minimum threshold. On real frames about half
-      // the cells are empty, so horizontally adjacent empty cells share one FAST call: measured
-      // 5.8-6.0 ms per frame against 6.6 ms for one minimum-threshold pass over the whole level
-      // (whose extra corners cost more score computations), and one call per cell was slower
-      // still.
+      // Cells left empty get a second pass at the minimum threshold. On real frames many cells
+      // are empty, so horizontally adjacent empty cells share one FAST call: cheaper than one
+      // minimum-threshold pass over the whole level (whose extra corners cost more score
+      // computations) and than one call per cell.
       int last_col = col;
       while (last_col + 1 < n_cols &&
              cell_counts_[static_cast<std::size_t>(row) * n_cols + last_col + 1] == 0)
@@ -303,11 +302,11 @@ void OrbExtractor::extract(const cv::Mat& gray, const cv::Mat& ignore_mask, OrbF
 
   for (int level = 0; level < levels(); ++level) detect_candidates(level, ignore_mask);
   // Mask compensation (OrbConfig::mask_compensation, off by default): a mask over most of the
-  // image leaves the levels fewer corners than their shares (bonn_crowd_dev, people over
-  // 55-72 % of frames 310-326: 548-983 of 1000 kept, where the semantic-only error peaks). A
-  // short level is searched again at the minimum threshold, then what is still missing goes to
-  // the levels with corners to spare, so that the count stays near n_features. Measured there,
-  // it keeps the count but costs accuracy in every mode (docs/benchmarks.md, issue #18 item 3).
+  // image leaves the levels fewer corners than their shares (frames where people cover most of
+  // the image keep well under n_features). A short level is searched again at the minimum
+  // threshold, then what is still missing goes to the levels with corners to spare, so that the
+  // count stays near n_features. On real crowded frames it keeps the count but costs accuracy in
+  // every mode, hence off (docs/decisions/mask-compensation.md).
   // Frames without masked pixels skip this and are extracted exactly as without compensation.
   level_budget_ = features_per_level_;
   if (config_.mask_compensation && !ignore_mask.empty() && cv::countNonZero(ignore_mask) > 0) {

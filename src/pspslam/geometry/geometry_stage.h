@@ -37,8 +37,8 @@ struct GeometryParams {
   // Test the points inside the previous frame's dynamic mask (warped into this frame by the
   // compensated homography) before walking the path.
   bool previous_mask_prior = true;
-  // Also return the previous mask warped into this frame (a full-image cv::warpPerspective, ~0.5 ms
-  // at 640x480). The prior itself needs no image: each keypoint is mapped back through H^-1.
+  // Also return the previous mask warped into this frame (a full-image cv::warpPerspective, a
+  // cost per frame). The prior itself needs no image: each keypoint is mapped back through H^-1.
   bool output_warped_previous_mask = false;
 
   static GeometryParams from_yaml(YamlSection& section);

@@ -104,8 +104,8 @@ MultiViewVerdict MultiViewTest::evaluate(const CandidatePoint& point) const {
     // centre settles it for most static points (one read). Otherwise the whole patch is scanned
     // without a data-dependent branch: its 2r+1 rows lie in different cache lines, and a
     // branch-free scan issues their loads together instead of one after another (a dynamic point
-    // must read every pixel anyway: "every valid pixel disagrees"). Measured and dropped: per
-    // reference cached 8x8-block depth bounds to settle dynamic votes without the scan
+    // must read every pixel anyway: "every valid pixel disagrees"). Per-reference cached 8x8-block
+    // depth bounds, to settle dynamic votes without the scan, do not pay for their upkeep
     // (docs/geometry.md).
     const float centre = ref.depth.ptr<float>(v)[u];
     bool consistent = centre > 0.0f && centre >= lower && centre <= upper;

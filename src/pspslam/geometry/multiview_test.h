@@ -22,8 +22,8 @@ enum class DepthDisagreement {
   either_sign,
 };
 
-// Parameters of the multi-view dynamic test (paper III.C, after DynaSLAM). Defaults: measured,
-// docs/geometry.md.
+// Parameters of the multi-view dynamic test (paper III.C, after DynaSLAM). Defaults: chosen by
+// experiment (docs/decisions/geometry-parameters.md).
 struct MultiViewParams {
   // A reference votes "dynamic" when the disagreement exceeds abs + relative * projected depth.
   double depth_threshold_abs_m = 0.04;

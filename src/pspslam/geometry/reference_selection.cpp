@@ -116,7 +116,7 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
         if (picked_[v] || pool[v].depth.empty()) continue;
         const std::uint8_t* seen = seen_.data() + static_cast<size_t>(v) * sampled;
         long gain = 0;
-        // Bitwise &: no branch per point, the loop vectorises (it was a fifth of the selection).
+        // Bitwise &: no branch per point, so this hot loop vectorises.
         for (size_t s = 0; s < sampled; ++s) gain += seen[s] & (coverage_[s] < wanted);
         gains_[v] = gain;
         best_gain = std::max(best_gain, gain);

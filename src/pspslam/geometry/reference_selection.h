@@ -46,9 +46,9 @@ class ReferenceSelector {
 
  private:
   // Per pool view, one validity bit per 8x8 block of its depth image, built the first time the
-  // view is seen (a look-up in ~20 full-size depth images per frame was mostly cache misses).
-  // Packed bits: a pool's maps take a few kB, so the per-frame look-ups hit L1 instead of
-  // missing in byte maps 8 times larger (the look-up was a third of the selection's time).
+  // view is seen (look-ups in the full-size depth images of every pool view would mostly miss
+  // the cache). Packed bits: a pool's maps take a few kB, so the per-frame look-ups hit L1
+  // instead of missing in byte maps 8 times larger.
   struct BlockValidity {
     int blocks_per_row = 0;
     std::vector<std::uint64_t> bits;  // bit by * blocks_per_row + bx: the block's centre is valid

@@ -18,20 +18,19 @@
 
 namespace pspslam {
 
-// A recorded sequence as a FrameSource. Deterministic by default: every frame, in order, read
-// by next() itself.
-// `paced` feeds it like a live camera (`pspslam run --realtime`): a reader thread decodes each
-// frame ahead of its time and delivers it when it is due (its timestamp after the first one,
-// counted from the first next()), into a newest-wins slot; next() takes the newest delivered
-// frame and waits when the caller is early. A frame the caller did not take before the next one
-// was delivered counts as dropped, as does one the reader skipped because it was late itself.
-// A frame's `arrival` is its due time: what a camera delivers decoded at that moment, so the
-// decoding of the recording's image files, which a camera does not have, is not part of the
-// latency measured from it (issue #18). A paced source may also decode every frame in the
-// constructor, before the clock starts (`preload`, `run --preload`), so that the replay puts no
-// decoding on the cores while it runs, as a camera would not: `on` does it or refuses (an Error)
-// above kPreloadLimitBytes of decoded frames, `automatic` does it up to kAutoPreloadBytes and
-// otherwise decodes on the reader thread.
+// A recorded sequence as a FrameSource. Deterministic by default: every frame, in order, read by
+// next() itself. `paced` feeds it like a live camera (`pspslam run --realtime`): a reader thread
+// decodes each frame ahead of its time and delivers it when it is due (its timestamp after the
+// first one, counted from the first next()), into a newest-wins slot; next() takes the newest
+// delivered frame and waits when the caller is early. A frame the caller did not take before the
+// next one was delivered counts as dropped, as does one the reader skipped because it was late
+// itself. A frame's `arrival` is its due time: what a camera delivers decoded at that moment, so
+// the decoding of the recording's image files, which a camera does not have, is not part of the
+// latency measured from it. A paced source may also decode every frame in the constructor, before
+// the clock starts (`preload`, `run --preload`), so that the replay puts no decoding on the cores
+// while it runs, as a camera would not: `on` does it or refuses (an Error) above kPreloadLimitBytes
+// of decoded frames, `automatic` does it up to kAutoPreloadBytes and otherwise decodes on the
+// reader thread.
 enum class Preload { off, automatic, on };
 
 class SequenceSource final : public FrameSource {

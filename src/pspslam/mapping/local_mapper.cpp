@@ -25,8 +25,8 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
 
   insert_keyframe_into_map(keyframe);
   if (place_ && !keyframe->is_bad()) {
-    // Here rather than in tracking (ORB-SLAM2 ProcessNewKeyFrame): the ~1 ms tree descent per
-    // keyframe stays off the tracking thread.
+    // Here rather than in tracking (ORB-SLAM2 ProcessNewKeyFrame): the vocabulary tree descent
+    // per keyframe stays off the tracking thread.
     keyframe->compute_bow(place_->vocabulary(), place_->direct_index_level());
     place_->database().add(keyframe->id(), keyframe->bow_vector());
   }

@@ -67,9 +67,9 @@ int search_previous_frame(Frame& current, const Frame& previous, double radius,
 // Reference-keyframe tracking without a vocabulary: brute-force descriptor matching of the
 // keyframe's keypoints that carry a map point against all keypoints of the frame, with ratio
 // test and rotation consistency. It needs no pose prediction, which is the point of this
-// fallback (it runs when the motion model failed). O(N*M) Hamming distances: ~1000 x 1000
-// popcounts, a couple of milliseconds, and only on fallback frames. Returns the number of
-// matches written into frame.map_points.
+// fallback (it runs when the motion model failed). O(N*M) Hamming distances: about a million
+// popcounts for two 1000-keypoint sets, affordable because it runs only on fallback frames. Returns
+// the number of matches written into frame.map_points.
 int search_keyframe_brute_force(Frame& frame, const KeyFrame& keyframe,
                                 const MatcherOptions& options = {});
 

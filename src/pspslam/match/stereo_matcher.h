@@ -7,7 +7,7 @@
 
 namespace pspslam {
 
-// Matching of one rectified stereo pair's ORB keypoints (issue #16, stereo).
+// Matching of one rectified stereo pair's ORB keypoints.
 struct StereoMatchOptions {
   // Nearest depth looked for: sets the widest disparity searched, bf / min_depth_m.
   double min_depth_m = 0.3;

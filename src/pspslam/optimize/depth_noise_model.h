@@ -9,8 +9,8 @@ namespace pspslam {
 // ORB-SLAM2 turns depth z into a virtual right coordinate u_r = u − bf/z and weighs it like a
 // pixel. But u_r carries the keypoint's own pixel error, so that row says the depth is known to
 // about z²/bf (bf ≈ 42 px: 24 mm at 1 m, 38 cm at 4 m) while an RGB-D sensor measures it ~15×
-// better. On the synthetic static sequence that under-weighting let every keyframe pose drift by
-// ~0.1° in rotation (ATE 11.8 mm); with the sensor model below it is 5.0 mm.
+// better. On the synthetic static sequence that under-weighting lets every keyframe pose drift
+// in rotation; the sensor model below removes most of that drift.
 //
 // When enabled, the third row of an RGB-D observation is the disparity bf/z, whitened by
 // σ_d = scale · bf · σ_z(z) / z² with the axial noise σ_z(z) = constant + quadratic (z − offset)²
@@ -19,12 +19,11 @@ namespace pspslam {
 //
 // Off by default, switched on per sensor by the camera config (`depth_noise: kinect_v1`, with
 // `depth_noise_scale` as `scale` for both pose-only optimisation and BA). On the synthetic
-// static sequences (depth registered and synchronised with colour) scale 2 gives ATE 4.1-4.2 mm
-// vs 14.3-17.8 mm with the u_r row (seeds 1 and 7, 600 frames). Real depth needs a looser model:
-// on bonn_crowd_dev scale 2 was 5x worse than the u_r row (2026-11-21), while since the depth
-// registration shift and the rolling-shutter correction scale 16 beats it in all 9 dev-clip
-// cells of the accuracy panel (config/bonn.yaml; docs/benchmarks.md, "Depth weighting on the
-// real clip"). The TUM presets keep the u_r row: not measured.
+// static sequences (depth registered and synchronised with colour) scale 2 is far more accurate
+// than the u_r row. Real depth needs a looser model: on the Bonn recordings, with the depth
+// registration shift and the rolling-shutter correction, scale 16 beats the u_r row while scale 2
+// is worse than it (config/bonn.yaml; docs/decisions/depth-weighting.md). The TUM presets keep
+// the u_r row: no experiment has compared the two there.
 struct DepthNoiseModel {
   bool enabled = false;
   double constant = 0.0012;   // metres

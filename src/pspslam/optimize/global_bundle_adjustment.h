@@ -28,10 +28,10 @@ struct GlobalBaOptions {
   double max_seconds = 120.0;
   std::function<bool()> should_stop;
   // How the depth row is weighed: must be the local BA's model (System passes the camera's).
-  // With the tracker and local BA on the sensor model but this on ORB-SLAM2's u_r row (15x
-  // looser), the global BA undid local BA's depth constraint: on the synthetic 1.5-turn loop two
-  // weakly connected keyframes (2 covisible keyframes each, 86-100 shared points) slid to 23-25 mm
-  // off (docs/benchmarks.md, #15 item 5). Default as BaOptions: the u_r row.
+  // With the tracker and local BA on the sensor model but this on ORB-SLAM2's u_r row (much
+  // looser), the global BA undoes local BA's depth constraint: weakly connected keyframes (few
+  // covisible keyframes, few shared points) slide along their viewing direction, away from the
+  // truth (tests/optimize/test_global_bundle_adjustment.cpp). Default as BaOptions: the u_r row.
   DepthNoiseModel depth_noise{.scale = 20.0};
 };
 

@@ -63,7 +63,7 @@ struct BaOptions {
   double chi2_stereo = 7.815;
   // Weight of the depth row. Much looser than in pose-only optimisation (σ_d ≈ 1.4 px, about the
   // u_r row's weight but without its pixel error): BA also moves the points, and on real depth a
-  // tight depth row there pulled the map off (bonn_crowd_dev 0-214: 57 mm with 1× vs 14 mm).
+  // tight depth row there pulls the map off (docs/decisions/depth-weighting.md).
   DepthNoiseModel depth_noise{.scale = 20.0};
   // Wall-clock budget for both stages together; stage 2 gets what stage 1 left.
   double max_seconds = 0.5;

@@ -1,8 +1,8 @@
 #pragma once
 
 // Pose-only optimisation (motion-only bundle adjustment) of one RGB-D frame against known map
-// points, ORB-SLAM2 semantics. Called by tracking on every frame, so it must stay cheap:
-// bench/bench_optimize BM_OptimizePose/500 (500 observations, 20% outliers) ≈ 1.5 ms CPU.
+// points, ORB-SLAM2 semantics. Called by tracking on every frame, so it must stay cheap
+// (bench/bench_optimize BM_OptimizePose/500: 500 observations, 20% outliers).
 //
 // Call pattern (tracking):
 //   std::vector<PoseObservation> observations;           // one per matched map point
@@ -63,10 +63,10 @@ struct PoseOptimizerOptions {
   // Fewer inliers than this after a round: stop, the pose is not constrained well enough to
   // keep refining (the remaining rounds would fit the few survivors).
   int min_inliers_to_continue = 10;
-  // Weight of the depth row: σ_d twice the Kinect-v1 model. Medians of 3 runs (ATE, u_r row →
-  // this): synthetic static 11.8 → 5.9 mm, bonn_crowd_dev frames 0-214 19.1 → 14.2 mm. 1× here (BA
-  // 10×) reaches 4.8 mm on the synthetic sequence but 26 mm on Bonn, whose real depth is worse
-  // than the model (registration, edges): the scale belongs to the sensor, not to the code.
+  // Weight of the depth row: σ_d twice the Kinect-v1 model, more accurate than the u_r row on
+  // both synthetic and real depth. 1× here is better still on the synthetic sequence but worse on
+  // real depth, which is worse than the model (registration, edges): the scale belongs to the
+  // sensor, not to the code (docs/decisions/depth-weighting.md).
   DepthNoiseModel depth_noise{.scale = 2.0};
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// The rotation rate of a rolling-shutter frame, measured from the frame's own matches (issue #15).
+// The rotation rate of a rolling-shutter frame, measured from the frame's own matches.
 //
 // A frame's keypoints were moved to its instant with a predicted rate w0
 // (camera/rolling_shutter.h). Where the true rate is w0 + rho, a keypoint on a row read dt after
@@ -11,8 +11,8 @@
 //
 // Why not difference the last two poses instead: each pose jitters by a few tenths of a degree on
 // real data, and over one frame interval that is a rate error of several degrees per second, a
-// third of the hand-held rate being corrected; fed back into the next frame's correction it made
-// the synthetic Kinect runs worse (docs/benchmarks.md, "Rolling shutter").
+// third of the hand-held rate being corrected; fed back into the next frame's correction it makes
+// the synthetic Kinect runs worse (docs/decisions/rolling-shutter.md).
 
 #include <vector>
 

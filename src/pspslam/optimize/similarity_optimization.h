@@ -3,9 +3,8 @@
 // Refinement of a loop's similarity by reprojection in both keyframes (ORB-SLAM2 OptimizeSim3).
 // The 3D-3D fit that finds the loop (solve/rigid_alignment) weighs every point's position
 // equally in all directions; a monocular map point's depth is known far worse than its bearing,
-// and on the synthetic seed-2 loop the fit's transform moved the current keyframe's neighbourhood
-// 0.32-0.34 m from the truth (docs/benchmarks.md). Reprojection errors measure what the keyframes
-// saw: bearings.
+// so the fit's transform can move the current keyframe's neighbourhood well away from the truth.
+// Reprojection errors measure what the keyframes saw: bearings.
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -185,8 +185,8 @@ ModelFit fit(Kind kind, std::span<const Eigen::Vector2d> p1, std::span<const Eig
   };
   for (const MinimalSet& set : sets) consider(set);
   // ORB-SLAM stops at the best minimal model and leaves the rest to bundle adjustment; a least-
-  // squares refit on its inliers, kept while it scores higher, is cheap and much closer (on the
-  // synthetic two-view test the 8-point model's translation direction was off by up to 5 deg).
+  // squares refit on its inliers, kept while it scores higher, is cheap and much closer (a
+  // minimal 8-point model's translation direction can be off by degrees).
   for (int round = 0; round < 3; ++round) {
     std::vector<int> inliers;
     for (size_t i = 0; i < best.inlier.size(); ++i) {

@@ -21,7 +21,7 @@ struct RoomLayout {
 // start (default 1.08: 8% of a turn past it), so the last frames revisit the first viewpoint
 // (for loop-closure tests; more turns = a longer revisit, e.g. for covisibility consistency).
 // Scales of the hand-held path's slow rotation, slow translation and hand shake (1, 1, 1: the
-// path as it always was).
+// ideal sensor's path).
 struct MotionProfile {
   double rotation = 1.0;
   double translation = 1.0;

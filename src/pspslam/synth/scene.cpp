@@ -149,10 +149,10 @@ void parallel_rows(int height, int threads, const Fn& fn) {
   for (std::thread& thread : pool) thread.join();
 }
 
-// Kinect hand-held motion: scales of the ideal path matched to the Bonn crowd clip's ground
-// truth (median 12.7 deg/s rotation and 0.085 m/s translation frame to frame, measured over
-// its 404 poses): 0.8 x rotation, 0.38 x translation and 2 x hand shake give medians of
-// 12.9 deg/s and 0.091 m/s (20 seeds x 13.3 s; the test pins the figures).
+// Kinect hand-held motion: scales of the ideal path (0.8 x rotation, 0.38 x translation, 2 x hand
+// shake) chosen so that the median frame-to-frame rotation and translation rates match the Bonn
+// crowd recording's ground truth (12.7 deg/s and 0.085 m/s over its 404 poses); the test pins the
+// match.
 synth::MotionProfile motion_profile(const SynthOptions& options) {
   if (options.sensor != SynthSensor::kKinect || !options.faults.handheld_motion) return {};
   return {0.8, 0.38, 2.0};
@@ -223,7 +223,7 @@ CameraConfig synthetic_camera_config() {
   config.depth_factor = 5000.0;
   config.depth_threshold = 4.0;
   // The rendered depth is registered and synchronised with colour, its noise is the Kinect v1
-  // model (sensor.h): trust it as such (halves the static 600-frame ATE, docs/benchmarks.md).
+  // model (sensor.h): trust it as such (optimize/depth_noise_model.h).
   config.depth_noise = CameraConfig::DepthNoise::kinect_v1;
   return config;
 }

@@ -24,9 +24,9 @@ inline constexpr int kMaxBodies = 200;
 
 enum class SynthTrajectory { kHandheld, kLoop };
 
-// ideal: the renderer as it was before issue #15 item 2 (registered, synchronised, global
-// shutter, no distortion; depth noise per --depth-noise). kinect: a hand-held structured-light
-// camera with the faults of SynthOptions::faults (synth/kinect.h).
+// ideal: a perfect RGB-D camera (registered, synchronised, global shutter, no distortion; depth
+// noise per --depth-noise). kinect: a hand-held structured-light camera with the faults of
+// SynthOptions::faults (synth/kinect.h).
 enum class SynthSensor { kIdeal, kKinect };
 SynthSensor parse_synth_sensor(const std::string& name);
 std::string to_string(SynthSensor sensor);

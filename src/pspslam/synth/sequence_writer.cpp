@@ -24,9 +24,9 @@ namespace {
 namespace fs = std::filesystem;
 
 void write_png(const fs::path& file, const cv::Mat& image) {
-  // Fastest zlib level with run-length matching: measured ~25% faster than the default
-  // strategy and the files come out slightly smaller (noisy depth and textures have few long
-  // matches). PNG encoding is most of the cost of writing a sequence.
+  // Fastest zlib level with run-length matching: faster than the default strategy and the files
+  // come out slightly smaller (noisy depth and textures have few long matches). PNG encoding is
+  // most of the cost of writing a sequence.
   static const std::vector<int> kParams = {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY,
                                            cv::IMWRITE_PNG_STRATEGY_RLE};
   bool ok = false;

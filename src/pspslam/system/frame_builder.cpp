@@ -62,14 +62,14 @@ class RgbdFrameBuilder final : public FrameBuilder {
 // keypoints are corners, often on a depth edge, where block matching lends the nearer surface's
 // disparity to the farther one's pixels; a background keypoint read from the dense image then
 // lies in front of what its reference keyframes saw there, which the multi-view test takes for
-// motion. On the synthetic stereo sequence that put 14k static pixels a frame into the geometry
-// mask (precision 0.55); with the keypoints' own depths, 0.4k (0.98; docs/benchmarks.md, #16).
+// motion. Read from the dense image, such depths fill the geometry mask with static pixels;
+// the keypoints' own depths keep it on what moves.
 class StereoFrameBuilder final : public FrameBuilder {
  public:
   // Twice the left image's features on the right: the quadtree keeps a different subset of
   // corners in each image, so a left keypoint's partner is often not among the right image's
-  // best n; doubling lifted the matched share of a rendered pair from 55 % to 65 %
-  // (tests/match, RenderedPairDisparityWithinAQuarterPixel), on the second thread.
+  // best n; doubling raises the matched share of a rendered pair (tests/match,
+  // RenderedPairDisparityWithinAQuarterPixel), and the right image runs on the second thread.
   static OrbConfig right_config(OrbConfig orb) {
     orb.n_features *= 2;
     return orb;
@@ -83,11 +83,11 @@ class StereoFrameBuilder final : public FrameBuilder {
         dense_depth_(dense_depth) {
     // Block matching at half resolution: the cost grows with width x height x disparities, and
     // the dynamic pipeline's depth tests tolerate 4 cm + 4 % (geometry/). Semi-global matching
-    // (cv::StereoSGBM, 3-way, 5x5 blocks) cost 8.5 ms a pair here against 2.8 ms, and with the
-    // candidates on their own depths it was also the less accurate of the two: on 12 synthetic
-    // stereo seeds StereoBM's runs had the lower ATE in 9 (online) and 10 (final) of 12
-    // (docs/benchmarks.md, issue #16). Disparities up to the nearest depth matched sparsely,
-    // rounded up to a multiple of 16, capped at 96 (nearer pixels get no depth); 11x11 blocks.
+    // (cv::StereoSGBM, 3-way, 5x5 blocks) costs several times as much a pair, and with the
+    // candidates on their own depths it is also the less accurate of the two on synthetic
+    // stereo sequences (lower ATE with StereoBM on most seeds). Disparities up to the nearest
+    // depth matched sparsely, rounded up to a multiple of 16, capped at 96 (nearer pixels get no
+    // depth); 11x11 blocks.
     const double max_disparity = 0.5 * camera_->bf / matching_.min_depth_m;
     const int disparities =
         std::clamp(static_cast<int>(std::ceil(max_disparity / 16.0)) * 16, 16, 96);

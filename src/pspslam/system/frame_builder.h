@@ -18,12 +18,12 @@
 namespace pspslam {
 
 // Everything that differs between sensors from the images to the Frame the tracker sees, in one
-// place (issue #16): past the Frame, tracking, mapping and loop closing treat every keypoint
-// alike, with a depth and a right coordinate u_r = u - bf / z (measured for stereo, derived from
-// the depth image with a virtual baseline for RGB-D), so the same stereo reprojection residual
-// serves both sensors in pose optimisation and bundle adjustment. A monocular keypoint has no
-// depth (< 0, right u NaN) and gets the 2-row residual everywhere; the sensors also differ in
-// how the map starts (make_map_initializer) and in a few local mapping rules (adapt).
+// place: past the Frame, tracking, mapping and loop closing treat every keypoint alike, with a
+// depth and a right coordinate u_r = u - bf / z (measured for stereo, derived from the depth image
+// with a virtual baseline for RGB-D), so the same stereo reprojection residual serves both sensors
+// in pose optimisation and bundle adjustment. A monocular keypoint has no depth (< 0, right u NaN)
+// and gets the 2-row residual everywhere; the sensors also differ in how the map starts
+// (make_map_initializer) and in a few local mapping rules (adapt).
 //
 // System drives it per frame: extract -> [dynamic pipeline: depth_image, remove_dynamic] -> build.
 class FrameBuilder {

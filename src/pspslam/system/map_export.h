@@ -18,11 +18,11 @@ struct DenseCloudOptions {
   double voxel_size_m = 0.01;  // one point per voxel (first keyframe wins); 0 keeps all
 };
 
-// Static map export (issue #7 part 6, `pspslam run --export-map`). Remembers the images of the
-// frames that became keyframes, with their fused dynamic masks, and turns the final map into
-// point clouds: the map points (dynamic ones never entered the map or were culled from it), and
-// optionally a dense cloud back-projected from the keyframes' depth at their final, BA-refined
-// poses with the dynamic pixels left out. Keyframes culled by local mapping are skipped.
+// Static map export (`pspslam run --export-map`). Remembers the images of the frames that became
+// keyframes, with their fused dynamic masks, and turns the final map into point clouds: the map
+// points (dynamic ones never entered the map or were culled from it), and optionally a dense cloud
+// back-projected from the keyframes' depth at their final, BA-refined poses with the dynamic pixels
+// left out. Keyframes culled by local mapping are skipped.
 class MapExporter {
  public:
   explicit MapExporter(PinholeCamera camera) : camera_(std::move(camera)) {}

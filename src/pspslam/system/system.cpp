@@ -235,7 +235,7 @@ System::System(const SystemConfig& config, SystemOptions options)
     loop_options.thread_nice = options.background_thread_nice;
     frame_builder_->adapt(loop_options);
     // The global BA weighs depth as local BA does; otherwise it moves weakly connected keyframes
-    // away from where local BA's depth constraint held them (#15 item 5).
+    // away from where local BA's depth constraint held them.
     if (config.camera.depth_noise == CameraConfig::DepthNoise::kinect_v1)
       loop_options.global_ba.depth_noise = {.enabled = true,
                                             .scale = config.camera.depth_noise_scale};
@@ -342,8 +342,8 @@ FrameReport System::process(const RgbdFrame& frame) {
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
   // The culler below and the next frame's geometry stage read map points and keyframe poses that
   // local mapping and loop closing refine: a deterministic run lets them finish this frame's
-  // keyframe first, or the result would depend on thread timing (bonn `exhaustive` varied
-  // 0.0183-0.0199 m run to run; a monocular loop's final file 6.4-15.8 mm).
+  // keyframe first, or the result would depend on thread timing and differ from run to run
+  // (docs/decisions/back-end-wait.md).
   wait_for_back_end();
   dynamic_->end_frame(report.tracking, depth, semantic_mask, report.dynamic);
   if (fates) record_fates_of_tracked_frame(*fates);

@@ -26,13 +26,13 @@ struct RgbdFrame;
 struct RgbdCamera;
 struct ScalePyramid;
 
-// Place recognition (issue #4): bag-of-words vocabulary and keyframe database.
+// Place recognition: bag-of-words vocabulary and keyframe database.
 struct PlaceOptions {
   // Vocabulary file (`pspslam run --vocabulary`); empty = default_vocabulary_path()
   // (models/vocabulary/orb_k10_l5.pspvoc in the source tree).
   std::filesystem::path vocabulary;
   // Relocalise a lost tracker against the keyframe database. Needs the vocabulary, which is
-  // then loaded (~0.1 s) and every keyframe gets a BoW vector in local mapping.
+  // then loaded at start-up and every keyframe gets a BoW vector in local mapping.
   bool relocalization = true;
   // Loop closing thread (`pspslam run --loop-closing`): detection, correction, global BA.
   // Needs the vocabulary and local mapping.
@@ -64,7 +64,7 @@ struct SystemOptions {
   // Nice increment of the semantic, local mapping and loop closing threads (and of the global
   // BA threads loop closing starts). A live run (--realtime, a camera) sets it so that the
   // caller thread, which must track each frame before the next one arrives, gets a core when
-  // it needs one and the background work takes what is left (issue #18 item 1).
+  // it needs one and the background work takes what is left (docs/decisions/realtime-nice.md).
   int background_thread_nice = 0;
   DynamicOptions dynamic;
   PlaceOptions place;

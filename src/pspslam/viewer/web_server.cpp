@@ -106,10 +106,10 @@ WebServer::WebServer(fs::path web_root, std::string index_file) : impl_(std::mak
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
   });
   // Debian's httplib compresses every text or JSON answer for a client that accepts it, with
-  // brotli at its slowest quality: measured 100 ms of CPU for a 55 KB map snapshot, 50 ms for an
-  // 18 KB event and 1.9 s for three.js, i.e. about a third of a core taken from SLAM while a page
-  // is open, to save bytes that mostly cross loopback. Requests are answered uncompressed; the
-  // Request is httplib's own non-const object, so dropping the header there is sound.
+  // brotli at its slowest quality: every map snapshot and event then costs CPU time that is taken
+  // from SLAM while a page is open, to save bytes that mostly cross loopback. Requests are answered
+  // uncompressed; the Request is httplib's own non-const object, so dropping the header there is
+  // sound.
   impl_->server.set_pre_routing_handler([](const httplib::Request& request, httplib::Response&) {
     const_cast<httplib::Request&>(request).headers.erase("Accept-Encoding");
     return httplib::Server::HandlerResponse::Unhandled;

@@ -18,9 +18,6 @@
 namespace pspslam::cli {
 namespace {
 
-// The camera stopped delivering (unplugged): everything recorded so far is on disk.
-constexpr int kCameraLostExit = 4;
-
 struct RecordFlags {
   std::string camera;
   std::string out;

@@ -52,8 +52,6 @@ namespace {
 constexpr int kInterruptedExit = 130;
 // The whole sequence ran and no frame ever started a map: nothing was tracked.
 constexpr int kNeverStartedExit = 3;
-// --camera: the camera stopped delivering (unplugged); the outputs hold every frame so far.
-constexpr int kCameraLostExit = 4;
 // Nice increment of the background threads in live runs (--background-nice; issue #18 item 1:
 // measured in docs/benchmarks.md "Real time on two cores").
 constexpr int kLiveBackgroundNice = 10;

@@ -10,6 +10,10 @@ namespace pspslam::cli {
 // the `run` closure owns, so everything is parsed and range-checked by CLI11 before any work
 // starts; `run` then does the work and returns the process exit status. Errors are thrown as
 // pspslam::Error and reported by main().
+// Exit status of `run --camera` and `record` when the camera stops delivering (unplugged): the
+// outputs hold every frame so far.
+inline constexpr int kCameraLostExit = 4;
+
 struct GlobalOptions {
   bool quiet = false;  // --quiet: no progress bar, only warnings and errors
 };

@@ -34,19 +34,19 @@ CASES = {
     "image four channels": (
         lambda f: (np.zeros(f.image.shape[:2] + (4,), np.uint8), np.array(f.depth), {}),
         ValueError,
-        "image: expected uint8 HxWx3 BGR or uint8 HxW gray, got 240x320x4 uint8"),
+        "image: expected uint8 HxWx3 BGR or uint8 HxW gray, got <HW>x4 uint8"),
     "image channels first": (
         lambda f: (np.ascontiguousarray(np.array(f.image).transpose(2, 0, 1)),
                    np.array(f.depth), {}), ValueError,
-        "image: expected uint8 HxWx3 BGR or uint8 HxW gray, got 3x240x320 uint8 "
+        "image: expected uint8 HxWx3 BGR or uint8 HxW gray, got 3x<HW> uint8 "
         "(channels first?)"),
     "image not contiguous": (
         lambda f: (np.array(f.image)[:, ::-1], np.array(f.depth), {}), ValueError,
-        "image: expected a C-contiguous array, got 240x320x3 uint8 with other strides (a slice "
+        "image: expected a C-contiguous array, got <HW>x3 uint8 with other strides (a slice "
         "or transpose; numpy.ascontiguousarray makes a contiguous copy)"),
     "image of another size": (
         lambda f: (np.zeros((120, 160, 3), np.uint8), np.zeros((120, 160), np.float32), {}),
-        ValueError, "image: expected the camera's size in CONFIG, 320x240 (width x height), "
+        ValueError, "image: expected the camera's size in CONFIG, <WH> (width x height), "
         "got 160x120"),
     "depth missing": (
         lambda f: (np.array(f.image), None, {}), ValueError,
@@ -56,15 +56,15 @@ CASES = {
         "depth: expected HxW uint16 raw depth units or HxW float32 metres, got dtype float64"),
     "depth with channels": (
         lambda f: (np.array(f.image), np.zeros(f.image.shape, np.uint16), {}), ValueError,
-        "depth: expected HxW uint16 raw depth units or HxW float32 metres, got 240x320x3 "
+        "depth: expected HxW uint16 raw depth units or HxW float32 metres, got <HW>x3 "
         "uint16"),
     "depth not contiguous": (
         lambda f: (np.array(f.image), np.asfortranarray(f.depth), {}), ValueError,
-        "depth: expected a C-contiguous array, got 240x320 float32 with other strides (a slice "
+        "depth: expected a C-contiguous array, got <HW> float32 with other strides (a slice "
         "or transpose; numpy.ascontiguousarray makes a contiguous copy)"),
     "depth of another size": (
-        lambda f: (np.array(f.image), np.zeros((240, 321), np.uint16), {}), ValueError,
-        "depth: expected the image's size 320x240 (width x height), got 321x240"),
+        lambda f: (np.array(f.image), np.zeros((480, 641), np.uint16), {}), ValueError,
+        "depth: expected the image's size <WH> (width x height), got 641x480"),
     "right on an rgbd system": (
         lambda f: (np.array(f.image), np.array(f.depth), {"right": np.array(f.gray)}),
         ValueError, "right: the rgbd sensor reads none, expected None"),
@@ -85,7 +85,9 @@ def test_bad_input_raises_with_its_message(case, geometry_system, frame, small_s
     make, error, message = CASES[case]
     image, depth, extra = make(frame)
     extra.setdefault("timestamp", 1e9)
-    message = message.replace("CONFIG", str(small_sequence / "config.yaml"))
+    height, width = frame.image.shape[:2]
+    message = (message.replace("CONFIG", str(small_sequence / "config.yaml"))
+               .replace("<HW>", f"{height}x{width}").replace("<WH>", f"{width}x{height}"))
     with pytest.raises(error, match="^" + re.escape(message) + "$"):
         geometry_system.track(image, depth, **extra)
 
@@ -105,7 +107,8 @@ def test_timestamps_going_back_raise(small_sequence, small_frames):
 def test_gray_image_needs_a_mode_without_semantics(small_sequence, frame):
     with pspslam.System(pspslam.read_sequence(small_sequence), mode="full") as slam:
         with pytest.raises(ValueError, match="^" + re.escape(
-                "image: expected uint8 HxWx3 BGR, got 240x320 uint8") + "$"):
+                f"image: expected uint8 HxWx3 BGR, got {frame.gray.shape[0]}x"
+                f"{frame.gray.shape[1]} uint8") + "$"):
             slam.track(np.array(frame.gray), np.array(frame.depth), timestamp=1.0)
 
 

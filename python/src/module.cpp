@@ -1,5 +1,5 @@
 // pspslam._pspslam: the compiled half of `import pspslam` (the package's __init__.py adds the
-// pure-Python helpers). Frames in and out are numpy arrays; see python/README in the report.
+// pure-Python helpers). Frames in and out are numpy arrays.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -45,6 +46,14 @@ void require_presence(const py::handle& object, bool needed, const char* argumen
                           " sensor reads none, expected None");
 }
 
+// Frames come in time order: a time going back (or standing still) is refused.
+void require_after(const std::optional<Timestamp>& previous, Timestamp timestamp) {
+  if (previous && !(timestamp > *previous)) {
+    throw py::value_error("timestamp: expected a time after the previous frame's " +
+                          std::to_string(*previous) + ", got " + std::to_string(timestamp));
+  }
+}
+
 void require_size(const cv::Mat& image, cv::Size expected, const std::string& argument,
                   const std::string& what) {
   if (image.size() != expected) {
@@ -74,8 +83,8 @@ PySystem::~PySystem() = default;
 std::unique_lock<std::mutex> PySystem::claim(const char* what) {
   std::unique_lock lock(busy_, std::try_to_lock);
   if (!lock.owns_lock()) {
-    throw py::value_error(std::string(what) +
-                          ": this System is busy in another thread (one thread at a time)");
+    throw std::runtime_error(std::string(what) +
+                             ": this System is busy in another thread (one thread at a time)");
   }
   return lock;
 }
@@ -88,7 +97,6 @@ PyFrame PySystem::make_frame(const py::handle& image, const py::handle& depth,
                              const py::handle& right, const py::handle& timestamp) {
   const SensorType sensor = config_.camera.type;
   auto frame = std::make_shared<RgbdFrame>();
-  frame->index = next_index_++;
   frame->timestamp = timestamp_value(timestamp);
   frame->depth_timestamp = frame->timestamp;
   const bool semantics = uses_semantics(options_.dynamic.mode);
@@ -113,6 +121,7 @@ PyFrame PySystem::make_frame(const py::handle& image, const py::handle& depth,
     frame->right = copy_image(right, {"right", false, true});
     require_size(frame->right, camera, "right", "the image's size");
   }
+  frame->index = next_index_++;
   return {std::move(frame)};
 }
 
@@ -125,21 +134,13 @@ void PySystem::check_next(const PyFrame& frame) const {
   const RgbdFrame& f = *frame.frame;
   const cv::Size camera(config_.camera.pinhole.width, config_.camera.pinhole.height);
   require_size(f.bgr, camera, "frame", "the camera's size in " + config_name_ + ",");
-  if (announced_.empty() && last_timestamp_ && !(f.timestamp > *last_timestamp_)) {
-    throw py::value_error("timestamp: expected a time after the previous frame's " +
-                          std::to_string(*last_timestamp_) + ", got " +
-                          std::to_string(f.timestamp));
-  }
+  if (announced_.empty()) require_after(last_timestamp_, f.timestamp);
 }
 
 void PySystem::announce(const PyFrame& frame) {
   auto lock = claim("announce");
   require_running("announce");
-  if (last_timestamp_ && !(frame.frame->timestamp > *last_timestamp_)) {
-    throw py::value_error("timestamp: expected a time after the previous frame's " +
-                          std::to_string(*last_timestamp_) + ", got " +
-                          std::to_string(frame.frame->timestamp));
-  }
+  require_after(last_timestamp_, frame.frame->timestamp);
   if (options_.dynamic.realtime) return;  // a real-time feed segments the newest frame only
   announced_.push_back(frame.frame);
   last_timestamp_ = frame.frame->timestamp;

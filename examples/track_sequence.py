@@ -16,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # files only, no display needed
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
 import numpy as np  # noqa: E402
 
 import pspslam  # noqa: E402
@@ -44,7 +45,7 @@ def plot(path, trajectory, ground_truth, ate, busiest):
         # The estimate in the ground truth's frame, moved by the ATE's alignment.
         positions = ate["scale"] * positions @ ate["rotation"].T + ate["translation"]
         truth = ground_truth[1][:, :3, 3]
-        top.plot(truth[:, 0], truth[:, 1], color="0.6", label="ground truth")
+        top.plot(truth[:, 0], truth[:, 1], color="0.75", linewidth=4, label="ground truth")
         top.set_title(f"ATE rmse {100 * ate['rmse']:.2f} cm")
     top.plot(positions[:, 0], positions[:, 1], color="tab:blue", label="pspslam")
     top.set_aspect("equal", adjustable="datalim")
@@ -53,7 +54,7 @@ def plot(path, trajectory, ground_truth, ate, busiest):
     top.legend()
     image, mask = busiest
     picture.imshow(image[:, :, ::-1])  # BGR -> RGB
-    picture.imshow(np.ma.masked_equal(mask, 0), cmap="autumn", alpha=0.5, vmin=0, vmax=255)
+    picture.imshow(np.ma.masked_equal(mask, 0), cmap=ListedColormap(["red"]), alpha=0.45)
     picture.set_title(f"dynamic mask ({np.count_nonzero(mask)} pixels)")
     picture.axis("off")
     figure.tight_layout()

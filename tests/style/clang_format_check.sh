@@ -8,7 +8,7 @@ if ! command -v clang-format >/dev/null; then
   exit 1
 fi
 cd "$root"
-mapfile -t files < <(find apps bench fuzz src tests -type f \( -name '*.cpp' -o -name '*.h' \) | sort)
+mapfile -t files < <(find apps bench fuzz python src tests -type f \( -name '*.cpp' -o -name '*.h' \) | sort)
 if [[ ${#files[@]} -lt 300 ]]; then
   echo "found only ${#files[@]} C++ files under $root: not the source tree?" >&2
   exit 1

@@ -244,6 +244,21 @@ std::string to_string(SensorType type) {
   return "rgbd";
 }
 
+namespace {
+
+SystemConfig read_config(const YAML::Node& root, const std::string& name) {
+  YamlSection top(root, name, "");
+  if (!top.contains("camera")) throw Error(name + ": missing key 'camera'");
+  SystemConfig config;
+  config.camera = read_camera(top.section("camera"));
+  config.orb = read_orb(top.section("orb"));
+  config.geometry = read_geometry(top.section("geometry"));
+  top.finish();
+  return config;
+}
+
+}  // namespace
+
 SystemConfig load_config(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw Error(file.string() + ": config file not found");
   YAML::Node root;
@@ -252,14 +267,17 @@ SystemConfig load_config(const std::filesystem::path& file) {
   } catch (const YAML::Exception& e) {
     throw Error(file.string() + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
   }
-  YamlSection top(root, file.string(), "");
-  if (!top.contains("camera")) throw Error(file.string() + ": missing key 'camera'");
-  SystemConfig config;
-  config.camera = read_camera(top.section("camera"));
-  config.orb = read_orb(top.section("orb"));
-  config.geometry = read_geometry(top.section("geometry"));
-  top.finish();
-  return config;
+  return read_config(root, file.string());
+}
+
+SystemConfig parse_config(const std::string& yaml, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw Error(name + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+  }
+  return read_config(root, name);
 }
 
 void save_config(const std::filesystem::path& file, const SystemConfig& config) {

@@ -83,6 +83,9 @@ struct SystemConfig {
 // Loads a config file. Any missing required key, unknown key or invalid value raises
 // pspslam::Error naming the file, the line and the key.
 SystemConfig load_config(const std::filesystem::path& file);
+// The same from YAML text (a config built in memory, e.g. a Python dict); errors name `name`
+// where load_config names the file.
+SystemConfig parse_config(const std::string& yaml, const std::string& name);
 
 // Writes a config that load_config reads back to the same values.
 void save_config(const std::filesystem::path& file, const SystemConfig& config);

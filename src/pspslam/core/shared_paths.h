@@ -13,7 +13,8 @@ std::filesystem::path source_dir();
 
 // The folder that holds the shipped data (models/, config/): DATA/share/pspslam next to an
 // installed program (bin/../share/pspslam, found from the running executable, so an installed
-// tree may be moved anywhere), else the source tree of a build that was not installed.
+// tree may be moved anywhere), or PREFIX/share/pspslam above the installed Python extension
+// that holds this code, else the source tree of a build that was not installed.
 std::filesystem::path data_dir();
 
 }  // namespace pspslam

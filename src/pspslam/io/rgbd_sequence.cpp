@@ -98,6 +98,10 @@ cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor,
     throw Error(file.string() + ": depth image must be 16-bit single-channel (got " +
                 describe_type(raw) + ")");
   }
+  return depth_to_metres(raw, depth_factor, shift_x, shift_y);
+}
+
+cv::Mat depth_to_metres(const cv::Mat& raw, double depth_factor, int shift_x, int shift_y) {
   cv::Mat metres;
   if (shift_x == 0 && shift_y == 0) {
     raw.convertTo(metres, CV_32F, 1.0 / depth_factor);

@@ -172,6 +172,8 @@ class RgbdSequence {
 // "<file>: depth image must be 16-bit single-channel (got 8-bit, 1 channel)".
 cv::Mat read_depth_image(const std::filesystem::path& file, double depth_factor, int shift_x = 0,
                          int shift_y = 0);
+// The conversion of read_depth_image on a 16-bit depth image already in memory (CV_16UC1).
+cv::Mat depth_to_metres(const cv::Mat& raw, double depth_factor, int shift_x = 0, int shift_y = 0);
 
 // Reads a colour image (PNG, JPEG, ...) as CV_8UC3 BGR.
 cv::Mat read_color_image(const std::filesystem::path& file);

@@ -1,0 +1,320 @@
+// pspslam._pspslam: the compiled half of `import pspslam` (the package's __init__.py adds the
+// pure-Python helpers). Frames in and out are numpy arrays.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "arrays.h"
+#include "evaluation.h"
+#include "pspslam/core/error.h"
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/core/version.h"
+#include "pspslam/io/sequence_setup.h"
+#include "python_system.h"
+#include "sequence_reader.h"
+#include "system_options.h"
+
+namespace pspslam::python {
+namespace {
+
+std::string type_name(const py::handle& object) {
+  return py::str(py::type::of(object).attr("__name__"));
+}
+
+// A keyword option of the given C++ type; TypeError naming it otherwise.
+template <typename T>
+T keyword_value(const py::handle& value, const std::string& keyword, const char* expected) {
+  const bool is_bool = py::isinstance<py::bool_>(value);
+  if constexpr (std::is_same_v<T, bool>) {
+    if (!is_bool)
+      throw py::type_error(keyword + ": expected " + expected + ", got " + type_name(value));
+  } else if constexpr (std::is_arithmetic_v<T>) {
+    if (is_bool || !(py::isinstance<py::int_>(value) ||
+                     (std::is_floating_point_v<T> && py::isinstance<py::float_>(value))))
+      throw py::type_error(keyword + ": expected " + expected + ", got " + type_name(value));
+  }
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(keyword + ": expected " + expected + ", got " + type_name(value));
+  }
+}
+
+std::filesystem::path path_value(const py::handle& value, const std::string& keyword) {
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__"))
+    throw py::type_error(keyword + ": expected a path (str or os.PathLike), got " +
+                         type_name(value));
+  return value.cast<std::filesystem::path>();
+}
+
+// Stores one keyword option into RunSettings, checking its type.
+using OptionSetter = void (*)(RunSettings&, const py::handle&, const std::string&);
+
+template <auto member, typename T>
+void set_value(RunSettings& settings, const py::handle& value, const std::string& keyword) {
+  constexpr const char* expected = std::is_same_v<T, bool>          ? "a bool"
+                                   : std::is_same_v<T, int>         ? "an int"
+                                   : std::is_same_v<T, double>      ? "a float"
+                                   : std::is_same_v<T, std::string> ? "a str"
+                                                                    : "(millimetres, degrees)";
+  settings.*member = keyword_value<T>(value, keyword, expected);
+}
+
+template <auto member>
+void set_path(RunSettings& settings, const py::handle& value, const std::string& keyword) {
+  settings.*member = path_value(value, keyword);
+}
+
+// The `pspslam run` flags as keywords: `--mask-margin 3` is mask_margin=3, `--no-local-mapping`
+// is local_mapping=False, `--no-relocalization` is relocalization=False.
+const std::vector<std::pair<std::string, OptionSetter>>& run_options() {
+  static const std::vector<std::pair<std::string, OptionSetter>> options = {
+      {"model", &set_path<&RunSettings::model>},
+      {"vocabulary", &set_path<&RunSettings::vocabulary>},
+      {"semantic_masks", &set_path<&RunSettings::semantic_masks>},
+      {"load_map", &set_path<&RunSettings::load_map>},
+      {"localization", &set_value<&RunSettings::localization, bool>},
+      {"realtime", &set_value<&RunSettings::realtime, bool>},
+      {"local_mapping", &set_value<&RunSettings::local_mapping, bool>},
+      {"relocalization", &set_value<&RunSettings::relocalization, bool>},
+      {"loop_closing", &set_value<&RunSettings::loop_closing, std::string>},
+      {"mask_margin", &set_value<&RunSettings::mask_margin, int>},
+      {"segment_every", &set_value<&RunSettings::segment_every, int>},
+      {"cull_hits", &set_value<&RunSettings::cull_hits, int>},
+      {"keyframe_ratio", &set_value<&RunSettings::keyframe_ratio, double>},
+      {"due_keyframes", &set_value<&RunSettings::due_keyframes, bool>},
+      {"local_ba_keyframes", &set_value<&RunSettings::local_ba_keyframes, int>},
+      {"background_nice", &set_value<&RunSettings::background_nice, int>},
+      {"motion_prior", &set_value<&RunSettings::motion_prior, std::pair<double, double>>},
+  };
+  return options;
+}
+
+RunSettings run_settings(const std::string& mode, const py::kwargs& keywords) {
+  RunSettings settings;
+  settings.mode = mode;
+  for (const auto& [key_object, value] : keywords) {
+    const std::string key = py::str(key_object);
+    const auto& options = run_options();
+    const auto option = std::find_if(options.begin(), options.end(),
+                                     [&](const auto& entry) { return entry.first == key; });
+    if (option == options.end()) {
+      std::string names;
+      for (const auto& entry : options) {
+        if (!names.empty()) names += ", ";
+        names += entry.first;
+      }
+      throw py::type_error("System: unexpected keyword '" + key + "' (the run options: " + names +
+                           ")");
+    }
+    option->second(settings, value, key);
+  }
+  return settings;
+}
+
+// The config argument: a YAML file, a dict of the same keys, or a sequence (its config as
+// `pspslam run` reads it: SEQUENCE/config.yaml, a KITTI calibration).
+std::pair<SystemConfig, std::string> config_from(const py::handle& config) {
+  if (py::isinstance<PySequence>(config)) {
+    const SequenceSetup& setup = config.cast<const PySequence&>().setup();
+    return {setup.config, setup.config_file.string()};
+  }
+  if (py::isinstance<py::dict>(config)) {
+    const std::string yaml = py::str(py::module_::import("json").attr("dumps")(config));
+    return {parse_config(yaml, "config dict"), "config dict"};
+  }
+  const std::filesystem::path file = path_value(config, "config");
+  return {load_config(file), file.string()};
+}
+
+std::unique_ptr<PySystem> make_system(const py::handle& config, const std::string& mode,
+                                      const std::optional<std::string>& sensor, bool keypoints,
+                                      const py::kwargs& options) {
+  const RunSettings settings = run_settings(mode, options);
+  auto [system_config, name] = config_from(config);
+  if (sensor) apply_sensor_override(system_config, parse_sensor_type(*sensor, "sensor"), name);
+  return std::make_unique<PySystem>(std::move(system_config), std::move(name), settings, keypoints);
+}
+
+py::object optional_view(const cv::Mat& mat) {
+  return mat.empty() ? py::none() : py::object(view_of(mat));
+}
+
+void register_frame(py::module_& m) {
+  py::class_<PyFrame>(m, "Frame",
+                      "One frame: image (HxWx3 uint8 BGR), depth (HxW float32 metres) or right "
+                      "(HxW uint8) as read-only views, timestamp (s), index, name.")
+      .def_property_readonly("index", [](const PyFrame& f) { return f.frame->index; })
+      .def_property_readonly("timestamp", [](const PyFrame& f) { return f.frame->timestamp; })
+      .def_property_readonly("name", [](const PyFrame& f) { return f.frame->name; })
+      .def_property_readonly("image", [](const PyFrame& f) { return view_of(f.frame->bgr); })
+      .def_property_readonly("gray", [](const PyFrame& f) { return optional_view(f.frame->gray); })
+      .def_property_readonly("depth",
+                             [](const PyFrame& f) { return optional_view(f.frame->depth); })
+      .def_property_readonly("right",
+                             [](const PyFrame& f) { return optional_view(f.frame->right); })
+      .def("__repr__", [](const PyFrame& f) {
+        return "<pspslam.Frame " + std::to_string(f.frame->index) +
+               " t=" + std::to_string(f.frame->timestamp) + " " +
+               std::to_string(f.frame->bgr.cols) + "x" + std::to_string(f.frame->bgr.rows) + ">";
+      });
+}
+
+py::array_t<float> keypoint_positions(const std::vector<KeypointRecord>& records) {
+  py::array_t<float> positions({static_cast<py::ssize_t>(records.size()), py::ssize_t{2}});
+  auto xy = positions.mutable_unchecked<2>();
+  for (size_t i = 0; i < records.size(); ++i) {
+    xy(static_cast<py::ssize_t>(i), 0) = records[i].position.x;
+    xy(static_cast<py::ssize_t>(i), 1) = records[i].position.y;
+  }
+  return positions;
+}
+
+py::array_t<std::uint8_t> keypoint_fates(const std::vector<KeypointRecord>& records) {
+  py::array_t<std::uint8_t> fates(static_cast<py::ssize_t>(records.size()));
+  auto fate = fates.mutable_unchecked<1>();
+  for (size_t i = 0; i < records.size(); ++i)
+    fate(static_cast<py::ssize_t>(i)) = static_cast<std::uint8_t>(records[i].fate);
+  return fates;
+}
+
+void register_result(py::module_& m) {
+  py::class_<PyResult>(m, "Result", "What track() made of one frame.")
+      .def_property_readonly("timestamp", [](const PyResult& r) { return r.timestamp; })
+      .def_property_readonly(
+          "pose",
+          [](const PyResult& r) -> py::object {
+            const std::optional<Pose>& pose = r.report.tracking.T_world_camera;
+            return pose ? py::object(pose_matrix(*pose)) : py::none();
+          },
+          "4x4 float64 camera-to-world pose, None when the frame was not tracked")
+      .def_property_readonly(
+          "state", [](const PyResult& r) { return to_string(r.report.tracking.state); },
+          "'ok', 'lost' or 'not_initialized'")
+      .def_property_readonly("method",
+                             [](const PyResult& r) { return to_string(r.report.tracking.method); })
+      .def_property_readonly("keyframe",
+                             [](const PyResult& r) { return r.report.tracking.keyframe_inserted; })
+      .def_property_readonly("inliers",
+                             [](const PyResult& r) { return r.report.tracking.num_inliers; })
+      .def_property_readonly(
+          "mask", [](const PyResult& r) { return view_of(r.mask); },
+          "the frame's final dynamic mask (semantic + geometry): HxW uint8, non-zero = dynamic; "
+          "a read-only view, no copy")
+      .def_property_readonly(
+          "keypoints", [](const PyResult& r) { return keypoint_positions(r.report.keypoints); },
+          "Nx2 float32 keypoint positions (pixels); empty unless System(keypoints=True)")
+      .def_property_readonly(
+          "fates", [](const PyResult& r) { return keypoint_fates(r.report.keypoints); },
+          "N uint8: what became of each keypoint, an index into pspslam.FATES")
+      .def_property_readonly(
+          "earlier_poses",
+          [](const PyResult& r) { return trajectory_arrays(r.report.tracking.earlier_frames); },
+          "(timestamps, poses) of earlier frames placed by the frame that started a monocular "
+          "map; empty otherwise")
+      .def_property_readonly(
+          "restarted", [](const PyResult& r) { return r.report.tracking.restart_due; },
+          "a monocular map was lost while young and starts anew: the poses "
+          "so far belong to the old map")
+      .def_property_readonly("extraction_ms",
+                             [](const PyResult& r) { return r.report.extraction_ms; })
+      .def_property_readonly("tracking_ms", [](const PyResult& r) { return r.report.tracking_ms; })
+      .def("__repr__", [](const PyResult& r) {
+        return "<pspslam.Result t=" + std::to_string(r.timestamp) + " " +
+               to_string(r.report.tracking.state) + ">";
+      });
+}
+
+void register_system(py::module_& m) {
+  py::class_<PySystem>(m, "System")
+      .def(py::init(&make_system), py::arg("config"), py::arg("mode") = "full",
+           py::arg("sensor") = py::none(), py::arg("keypoints") = false)
+      .def(
+          "make_frame",
+          [](PySystem& s, const py::handle& image, const py::handle& depth, const py::handle& right,
+             const py::handle& timestamp) { return s.make_frame(image, depth, right, timestamp); },
+          py::arg("image"), py::arg("depth") = py::none(), py::arg("right") = py::none(),
+          py::kw_only(), py::arg("timestamp") = py::none())
+      .def(
+          "track",
+          [](PySystem& s, const py::handle& image, const py::handle& depth, const py::handle& right,
+             const py::handle& timestamp) {
+            if (py::isinstance<PyFrame>(image)) {
+              if (!depth.is_none() || !right.is_none() || !timestamp.is_none())
+                throw py::value_error("track: a Frame carries its own depth, right and timestamp");
+              return s.track(image.cast<const PyFrame&>());
+            }
+            return s.track(s.make_frame(image, depth, right, timestamp));
+          },
+          py::arg("image"), py::arg("depth") = py::none(), py::arg("right") = py::none(),
+          py::kw_only(), py::arg("timestamp") = py::none())
+      .def("announce", &PySystem::announce, py::arg("frame"))
+      .def("shutdown", &PySystem::shutdown)
+      .def("map_points", &PySystem::map_points)
+      .def("keyframe_poses", &PySystem::keyframe_trajectory)
+      .def("save_map", &PySystem::save_map, py::arg("path"))
+      .def_property_readonly("mode", &PySystem::dynamic_mode)
+      .def_property_readonly("sensor",
+                             [](const PySystem& s) { return to_string(s.config().camera.type); })
+      .def_property_readonly("image_size", [](const PySystem& s) {
+        return py::make_tuple(s.config().camera.pinhole.width, s.config().camera.pinhole.height);
+      });
+}
+
+void register_sequence(py::module_& m) {
+  py::class_<PySequence, std::shared_ptr<PySequence>>(m, "Sequence")
+      .def(py::init([](const py::handle& folder, const py::handle& config,
+                       const std::optional<std::string>& sensor, size_t max_frames) {
+             std::optional<std::filesystem::path> config_file;
+             if (!config.is_none()) config_file = path_value(config, "config");
+             return std::make_shared<PySequence>(path_value(folder, "folder"), config_file, sensor,
+                                                 max_frames);
+           }),
+           py::arg("folder"), py::arg("config") = py::none(), py::arg("sensor") = py::none(),
+           py::arg("max_frames") = 0)
+      .def("__len__", &PySequence::size)
+      .def("__getitem__", &PySequence::frame)
+      .def("__iter__",
+           [](const std::shared_ptr<PySequence>& sequence) {
+             return PySequenceIterator{sequence, 0};
+           })
+      .def_property_readonly("ground_truth", &PySequence::ground_truth)
+      .def_property_readonly("config_file",
+                             [](const PySequence& s) { return s.setup().config_file; })
+      .def_property_readonly("folder",
+                             [](const PySequence& s) { return s.setup().sequence.directory(); });
+  py::class_<PySequenceIterator>(m, "SequenceIterator")
+      .def("__iter__", [](PySequenceIterator& it) -> PySequenceIterator& { return it; })
+      .def("__next__", [](PySequenceIterator& it) {
+        if (it.next >= it.sequence->size()) throw py::stop_iteration();
+        return it.sequence->frame(it.next++);
+      });
+}
+
+}  // namespace
+}  // namespace pspslam::python
+
+PYBIND11_MODULE(_pspslam, m) {
+  using namespace pspslam;
+  using namespace pspslam::python;
+  m.doc() = "pspslam: visual SLAM with dynamic-feature removal, driven from numpy.";
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+  m.attr("FATES") = py::make_tuple("tracked", "unmatched", "semantic", "geometry");
+  m.attr("__version__") = version_string();
+  m.def("data_dir", &data_dir, "Where the shipped models, vocabulary and configs are.");
+  register_frame(m);
+  register_result(m);
+  register_system(m);
+  register_sequence(m);
+  register_evaluation(m);
+}

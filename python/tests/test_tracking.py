@@ -1,0 +1,116 @@
+"""The module against the CLI: same trajectory bytes, masks as documented, the GIL released."""
+
+import threading
+
+import numpy as np
+
+import pspslam
+
+
+def test_trajectory_is_byte_identical_to_the_cli(synthetic_sequence, cli_run, tmp_path):
+    sequence = pspslam.read_sequence(synthetic_sequence)
+    timestamps, poses = [], []
+    with pspslam.System(sequence) as slam:
+        for frame, result in slam.track_frames(sequence):
+            if result.pose is not None:
+                timestamps.append(frame.timestamp)
+                poses.append(result.pose)
+    ours = tmp_path / "trajectory.txt"
+    pspslam.write_trajectory(ours, (np.array(timestamps), np.array(poses)))
+    expected = (cli_run / "trajectory.txt").read_bytes()
+    assert len(timestamps) > 50
+    assert ours.read_bytes() == expected
+
+
+def test_numpy_frames_track_as_the_reader_frames(small_sequence, small_frames):
+    """track(image, depth, timestamp=...) from plain arrays, one by one, gives the poses of the
+    reader's frames fed ahead (track_frames): the arrays path changes nothing."""
+    sequence = pspslam.read_sequence(small_sequence)
+    with pspslam.System(sequence) as slam:
+        ahead = [result.pose for _, result in slam.track_frames(small_frames)]
+    with pspslam.System(sequence) as slam:
+        plain = [slam.track(np.array(f.image), np.array(f.depth), timestamp=f.timestamp).pose
+                 for f in small_frames]
+    assert len(ahead) == len(plain)
+    for a, b in zip(ahead, plain):
+        assert (a is None) == (b is None)
+        if a is not None:
+            np.testing.assert_array_equal(a, b)
+
+
+def test_mask_is_a_read_only_uint8_view_of_the_frame_size(small_sequence, small_frames):
+    with pspslam.System(pspslam.read_sequence(small_sequence)) as slam:
+        results = [result for _, result in slam.track_frames(small_frames)]
+    height, width = small_frames[0].image.shape[:2]
+    for result in results:
+        mask = result.mask
+        assert mask.shape == (height, width)
+        assert mask.dtype == np.uint8
+        assert not mask.flags.writeable
+    # People walk through the synthetic room: some frame has dynamic pixels.
+    assert any(np.count_nonzero(r.mask) > 0 for r in results)
+    assert {r.state for r in results} <= {"ok", "lost", "not_initialized"}
+    # The view keeps the system's mask alive after its result is gone.
+    mask, expected = results[-1].mask, results[-1].mask.copy()
+    del results
+    np.testing.assert_array_equal(mask, expected)
+
+
+def test_pose_state_keypoints_and_map(small_sequence, small_frames, tmp_path):
+    sequence = pspslam.read_sequence(small_sequence)
+    with pspslam.System(sequence, keypoints=True) as slam:
+        results = [result for _, result in slam.track_frames(small_frames)]
+        last = results[-1]
+        assert last.state == "ok"
+        assert last.pose.shape == (4, 4)
+        np.testing.assert_allclose(last.pose[3], [0, 0, 0, 1])
+        assert last.keypoints.shape[1] == 2 and last.keypoints.dtype == np.float32
+        assert last.fates.shape == (len(last.keypoints),)
+        assert {pspslam.FATES[f] for f in last.fates} >= {"tracked"}
+        points = slam.map_points()
+        assert points.ndim == 2 and points.shape[1] == 3 and len(points) > 100
+        stamps, poses = slam.keyframe_poses()
+        assert len(stamps) >= 1 and poses.shape == (len(stamps), 4, 4)
+        counts = slam.save_map(tmp_path / "map.bin")
+    assert counts[0] == len(stamps)
+    # A saved map loads through the constructor and the first frame is relocalised in it.
+    with pspslam.System(sequence, load_map=tmp_path / "map.bin", localization=True) as slam:
+        result = slam.track(small_frames[5])
+        assert result.state == "ok"
+
+
+def test_other_threads_run_while_a_frame_is_tracked(small_sequence, small_frames):
+    counter = 0
+    running = threading.Event()
+    stop = threading.Event()
+
+    def count():
+        nonlocal counter
+        running.set()
+        while not stop.is_set():
+            counter += 1
+
+    with pspslam.System(pspslam.read_sequence(small_sequence)) as slam:
+        thread = threading.Thread(target=count)
+        thread.start()
+        running.wait()
+        during = []
+        for frame in small_frames:
+            before = counter
+            slam.track(frame)
+            during.append(counter - before)
+        stop.set()
+        thread.join()
+    # With the GIL held for the whole frame the counter could not move while track() runs.
+    assert sum(during) > 1000, during
+
+
+def test_ate_and_rpe_match_the_cli_eval(synthetic_sequence, cli_run):
+    gt = pspslam.read_trajectory(synthetic_sequence / "groundtruth.txt")
+    est = pspslam.read_trajectory(cli_run / "trajectory.txt")
+    ate = pspslam.ate(gt, est)
+    assert 0 < ate["rmse"] < 0.05 and ate["count"] > 50
+    rows = np.loadtxt(cli_run / "trajectory.txt")
+    assert pspslam.ate(gt, rows)["rmse"] == ate["rmse"]
+    rpe = pspslam.rpe(gt, est, delta=10, unit="f")
+    assert rpe["translation"]["count"] > 0

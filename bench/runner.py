@@ -278,8 +278,10 @@ def commit_of(folder):
     return commit + (" with uncommitted changes" if git("status", "--porcelain", "-uno") else "")
 
 
-def regenerate_command(args):
-    words = ["python3", *sys.argv]
+def regenerate_command():
+    # The script itself, not "python3 script": its first line names the system interpreter,
+    # which has matplotlib and dask where another python3 may come first on PATH.
+    words = [os.path.relpath(Path(sys.argv[0]).resolve(), Path.cwd()), *sys.argv[1:]]
     if "PSPSLAM_SHARED" in os.environ and "--shared" not in sys.argv:
         words.insert(0, f"PSPSLAM_SHARED={os.environ['PSPSLAM_SHARED']}")
     return " ".join(shlex.quote(word) for word in words)
@@ -287,7 +289,7 @@ def regenerate_command(args):
 
 def provenance(args, setup, executor, counts, loads):
     source = build_source(setup.build) or REPO
-    return [f"Regenerate: `{regenerate_command(args)}`", "",
+    return [f"Regenerate: `{regenerate_command()}`", "",
             f"_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; build `{setup.build}` at "
             f"commit {commit_of(source)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
             f"{cpu_model()}, {os.cpu_count()} cores; load average {loads[0]:.1f} before, "

@@ -5,9 +5,11 @@ result)` and `failed(job, error)` once a job has failed `retries + 1` times. A j
 process dies (killed, out of memory) counts as a failed attempt and is run again elsewhere.
 """
 import concurrent.futures
+import tempfile
 import uuid
+import zipfile
+from pathlib import Path
 
-import pspbench
 from .jobs import run_job
 
 
@@ -45,19 +47,28 @@ class DaskCluster:
 
     def __init__(self, address, retries):
         try:
-            import cloudpickle
             import distributed
         except ImportError as error:
             raise SystemExit(f"runner.py: --scheduler needs dask.distributed ({error}); install "
                              "python3-distributed or run without --scheduler") from None
-        # Workers need not have bench/ on their path: the runner's code travels with each task.
-        cloudpickle.register_pickle_by_value(pspbench)
         self.distributed = distributed
         try:
             self.client = distributed.Client(address, timeout=30)
         except OSError as error:
             raise SystemExit(f"runner.py: --scheduler {address}: cannot connect ({error})") from None
         self.address, self.retries = address, retries
+        self.upload_runner_code()
+
+    def upload_runner_code(self):
+        """Sends this package to every worker (and any that joins later): tasks refer to
+        pspbench.jobs.run_job by name, and workers need not have bench/ on their path."""
+        package = Path(__file__).resolve().parent
+        with tempfile.TemporaryDirectory() as folder:
+            archive = Path(folder) / "pspbench.zip"
+            with zipfile.ZipFile(archive, "w") as zipped:
+                for source in sorted(package.glob("*.py")):
+                    zipped.write(source, f"pspbench/{source.name}")
+            self.client.upload_file(str(archive))
 
     def describe(self):
         workers = self.client.scheduler_info()["workers"]

@@ -225,7 +225,7 @@ def tables(experiment, table):
 
 def plot(experiment, table, target):
     """Bars of each whole cell's median ATE per variant (lowest–highest as error bars); returns
-    False when there is nothing to draw."""
+    False when there is nothing to draw or no matplotlib to draw it."""
     if experiment.kind != "slam":
         return False
     cells = [c.name for c in experiment.cells]
@@ -236,7 +236,10 @@ def plot(experiment, table, target):
         series[variant.name] = summaries
     if not any(s.median is not None for ss in series.values() for s in ss):
         return False
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        return False
     matplotlib.use("Agg")
     from matplotlib import pyplot
 

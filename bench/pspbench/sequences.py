@@ -9,6 +9,8 @@ import json
 import os
 import shutil
 import subprocess
+import threading
+import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -84,17 +86,24 @@ def _source_folder(cell, variant, setup):
     return folder, content.folder_identity(folder)
 
 
+_locks_guard = threading.Lock()
+_locks = {}
+
+
 def _make_once(target, build):
-    """Runs build(temporary_folder) unless `target` exists, then renames it into place."""
-    if target.is_dir():
-        return
-    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-    shutil.rmtree(temporary, ignore_errors=True)
-    build(temporary)
-    try:
-        temporary.rename(target)
-    except OSError:  # made meanwhile by another runner
-        shutil.rmtree(temporary, ignore_errors=True)
+    """Runs build(temporary_folder) unless `target` exists, then renames it into place. Cells
+    that share a sequence wait for the one that makes it."""
+    with _locks_guard:
+        lock = _locks.setdefault(target, threading.Lock())
+    with lock:
+        if target.is_dir():
+            return
+        temporary = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
+        build(temporary)
+        try:
+            temporary.rename(target)
+        except OSError:  # made meanwhile by another runner
+            shutil.rmtree(temporary, ignore_errors=True)
 
 
 def _synthetic(cell, variant, setup):
@@ -243,7 +252,7 @@ def _write_stretch_ground_truth(folder, target, first, last):
     t1 = float(rgb[last - 1].split()[0]) + 0.02
     comments, rows = _read_list(folder / "groundtruth.txt")
     target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    temporary = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
     _write_list(temporary, comments, [r for r in rows if t0 <= float(r.split()[0]) <= t1])
     temporary.replace(target)
 

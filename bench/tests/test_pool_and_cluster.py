@@ -152,3 +152,24 @@ def test_killed_worker_still_leaves_a_complete_table(local_tables, cluster, tmp_
     assert len(finished) == len(set(finished)) == RUNS
     attempts = list((work / "runs").glob("*/attempt-*"))
     assert len(attempts) > RUNS
+
+
+def test_killed_pool_process_still_leaves_a_complete_table(local_tables, tmp_path, build):
+    work, results = tmp_path / "work", tmp_path / "results.md"
+    runner = subprocess.Popen(
+        [sys.executable, str(Path(__file__).parents[1] / "runner.py"), "run",
+         str(local_tables["experiment"]), "--work", str(work), "--results", str(results),
+         "--jobs", "2", "--build", str(build)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    running = work / "running"
+    Cluster.wait_for(lambda: running.is_dir() and any(running.iterdir()), "a run to start")
+    victim = int(next(running.iterdir()).read_text())
+    # Only a process of this runner's pool: its parent is the runner.
+    assert Path(f"/proc/{victim}/stat").read_text().split(") ")[1].split()[1] == str(runner.pid)
+    os.kill(victim, signal.SIGKILL)
+    stdout, stderr = runner.communicate(timeout=300)
+    assert runner.returncode == 0, stderr[-3000:]
+    assert "attempt failed, running it again" in stderr
+    assert section_tables(results, "tiny") == local_tables["tables"]
+    finished = [line.split()[0] for line in executed_runs(work)]
+    assert len(finished) == len(set(finished)) == RUNS

@@ -10,7 +10,6 @@ experiments that share a run share its result.
 """
 import argparse
 import concurrent.futures
-import json
 import os
 import platform
 import shlex
@@ -55,7 +54,8 @@ def parse_arguments(argv):
                      help="folder holding downloaded sequences (TUM, Bonn) by their official "
                           "folder names (default: $PSPSLAM_DATA); cells not found there are "
                           "listed as missing")
-    run.add_argument("--shared", default=os.environ.get("PSPSLAM_SHARED", str(REPO.parent / "shared")),
+    run.add_argument("--shared",
+                     default=os.environ.get("PSPSLAM_SHARED", str(REPO.parent / "shared")),
                      help="the project's shared folder (default: $PSPSLAM_SHARED or ../shared)")
     run.add_argument("--work", default=os.environ.get("PSPSLAM_BENCH_WORK", "/tmp/pspslam-bench"),
                      help="folder for sequences, runs and results; shared by experiments "
@@ -162,15 +162,17 @@ def make_job(experiment, cell, variant, prepared, repeat, setup, cli, cli_sha256
     # run), the digests of the things they name are in.
     recipe = {"format": RESULT_FORMAT, "kind": experiment.kind, "pspslam_sha256": cli_sha256,
               "models_sha256": setup.models_sha256, "data": prepared.identity,
-              "config": None if prepared.config_text is None else content.digest(prepared.config_text),
+              "config": (None if prepared.config_text is None
+                         else content.digest(prepared.config_text)),
               "arguments": [a.replace(str(prepared.folder), "SEQUENCE") for a in command[1:]],
               "env": variant.env, "repeat": repeat,
               "stretches": [[s["name"], content.file_sha256(s["ground_truth"])]
                             for s in prepared.stretches],
-              "model_file": None if not variant.model else content.file_sha256(REPO / variant.model)}
+              "model_file": variant.model and content.file_sha256(REPO / variant.model)}
     return {"key": content.digest(recipe), "recipe": recipe, "kind": experiment.kind,
             "label": f"{cell.name} · {variant.name} · run {repeat + 1}", "command": command,
-            "cwd": str(REPO), "env": variant.env, "config_text": prepared.config_text,
+            "cwd": str(REPO), "env": {"PSPSLAM_SHARED": str(setup.shared), **variant.env},
+            "config_text": prepared.config_text,
             "stretches": prepared.stretches, "sequence": str(prepared.folder),
             "work": str(setup.work)}
 
@@ -346,8 +348,8 @@ def main(argv=None):
     log(f"{len(all_jobs)} runs: {len(all_jobs) - len(pending)} have results, {len(pending)} to run")
     if args.dry_run:
         for job in all_jobs:
-            print(f"{'to run ' if job in pending else 'done   '} {job['label']}  {job['key'][:12]}  "
-                  f"{shlex.join(job['command'])}")
+            state = "to run" if job in pending else "done"
+            print(f"{state:7} {job['label']}  {job['key'][:12]}  {shlex.join(job['command'])}")
         return 0
     loads = [os.getloadavg()[0]]
     executor = (DaskCluster(args.scheduler, args.retries) if args.scheduler

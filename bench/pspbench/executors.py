@@ -55,7 +55,8 @@ class DaskCluster:
         try:
             self.client = distributed.Client(address, timeout=30)
         except OSError as error:
-            raise SystemExit(f"runner.py: --scheduler {address}: cannot connect ({error})") from None
+            raise SystemExit(f"runner.py: --scheduler {address}: cannot connect "
+                             f"({error})") from None
         self.address, self.retries = address, retries
         self.upload_runner_code()
 

@@ -133,7 +133,8 @@ class Fields:
     def reject_unknown(self):
         unknown = sorted(set(self.table) - self.read)
         if unknown:
-            raise self.error(unknown[0], f"unknown field (known here: {', '.join(sorted(self.read))})")
+            known = ", ".join(sorted(self.read))
+            raise self.error(unknown[0], f"unknown field (known here: {known})")
 
 
 def _kind_name(kind):
@@ -213,7 +214,8 @@ def _read_cell(fields, kind):
         raise fields.error(source, f"not allowed in a kind = \"{kind}\" experiment")
     cell = Cell(name=name, source=source, location=sources.get(source) or "", synth=synth or {},
                 config=fields.get("config", str), config_set=_config_settings(fields, "set"),
-                start=fields.get_count("start", 0, 0), max_frames=fields.get_count("max_frames", 0, 0),
+                start=fields.get_count("start", 0, 0),
+                max_frames=fields.get_count("max_frames", 0, 0),
                 reencode_jpeg=fields.get_count("reencode_jpeg", 0, 0),
                 stretches=_read_stretches(fields), split=fields.get("split", str),
                 split_key=fields.get("split_key", str, "val"),
@@ -226,8 +228,8 @@ def _read_cell(fields, kind):
         return [cell]
     if source != "synth":
         raise fields.error("seeds", "only a synth cell has seeds")
-    return [Cell(**{**cell.__dict__, "name": f"{name}_s{seed}", "synth": {**cell.synth, "seed": seed}})
-            for seed in seeds]
+    return [Cell(**{**cell.__dict__, "name": f"{name}_s{seed}",
+                    "synth": {**cell.synth, "seed": seed}}) for seed in seeds]
 
 
 def _read_variants(fields, modes):

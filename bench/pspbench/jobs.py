@@ -28,7 +28,7 @@ def read_result(work, key):
 
 def write_atomically(path, text):
     path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.{uuid.uuid4().hex}")
+    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}")
     with open(temporary, "w") as stream:
         stream.write(text)
         stream.flush()
@@ -43,7 +43,8 @@ def run_job(job):
     if finished is not None:
         return finished
     work = Path(job["work"])
-    attempt = work / "runs" / job["key"] / f"attempt-{socket.gethostname()}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    attempt_name = f"attempt-{socket.gethostname()}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    attempt = work / "runs" / job["key"] / attempt_name
     attempt.mkdir(parents=True)
     marker = work / "running" / f"{job['key']}.{socket.gethostname()}.{os.getpid()}"
     marker.parent.mkdir(parents=True, exist_ok=True)
@@ -129,7 +130,8 @@ def measure_segment(job, attempt):
         columns = numpy.arange(predicted.shape[1]) * truth.shape[1] // predicted.shape[1]
         truth = truth[rows][:, columns]
         union = numpy.logical_or(predicted, truth).sum()
-        ious[photo.stem] = float(numpy.logical_and(predicted, truth).sum() / union) if union else 1.0
+        both = numpy.logical_and(predicted, truth).sum()
+        ious[photo.stem] = float(both / union) if union else 1.0
     timing = re.search(r"median ([0-9.]+) ms", log)
     return {"ious": ious, "mean_iou": sum(ious.values()) / len(ious),
             "median_ms": float(timing.group(1)) if timing else None}

@@ -161,7 +161,8 @@ def stats_value(result, dotted):
 def column_table(experiment, table):
     """The experiment's extra columns (stats.json fields), median over repeats."""
     labels = list(experiment.columns)
-    lines = [f"Median over runs of {', '.join(f'{k} (`{v}`)' for k, v in experiment.columns.items())}:",
+    described = ", ".join(f"{k} (`{v}`)" for k, v in experiment.columns.items())
+    lines = [f"Median over runs of {described}:",
              "", f"| cell | variant | {' | '.join(labels)} |", "|---|---|" + "---|" * len(labels)]
     for cell in experiment.cells:
         for variant in experiment.variants:
@@ -175,42 +176,40 @@ def column_table(experiment, table):
     return lines
 
 
-def segment_tables(experiment, table):
-    lines = ["| cell | variant | mean person IoU | median ms per image | images |",
-             "|---|---|---|---|---|"]
+def finished_runs(experiment, table, lines):
+    """(cell, variant, its finished results) for every cell and variant; a missing one gets its
+    row in `lines` instead."""
     for cell in experiment.cells:
         for variant in experiment.variants:
             runs = table[cell.name][variant.name]
             if runs.missing:
                 lines.append(f"| {cell.name} | {variant.name} | missing: {runs.missing} | | |")
                 continue
-            done = [r for r in runs.results if r]
-            iou = stats.median_or_none([r["mean_iou"] for r in done])
-            ms = stats.median_or_none([r["median_ms"] for r in done])
-            lines.append(f"| {cell.name} | {variant.name} | "
-                         f"{'—' if iou is None else f'{iou:.4f}'} | "
-                         f"{'—' if ms is None else f'{ms:.1f}'} | "
-                         f"{len(done[0]['ious']) if done else '—'} |")
+            yield cell.name, variant.name, [r for r in runs.results if r]
+
+
+def segment_tables(experiment, table):
+    lines = ["| cell | variant | mean person IoU | median ms per image | images |",
+             "|---|---|---|---|---|"]
+    for cell, variant, done in finished_runs(experiment, table, lines):
+        iou = stats.median_or_none([r["mean_iou"] for r in done])
+        ms = stats.median_or_none([r["median_ms"] for r in done])
+        lines.append(f"| {cell} | {variant} | {'—' if iou is None else f'{iou:.4f}'} | "
+                     f"{'—' if ms is None else f'{ms:.1f}'} | "
+                     f"{len(done[0]['ious']) if done else '—'} |")
     return lines
 
 
 def gbench_tables(experiment, table):
     lines = ["| cell | variant | benchmark | real time | CPU time |", "|---|---|---|---|---|"]
-    for cell in experiment.cells:
-        for variant in experiment.variants:
-            runs = table[cell.name][variant.name]
-            if runs.missing:
-                lines.append(f"| {cell.name} | {variant.name} | missing: {runs.missing} | | |")
-                continue
-            done = [r for r in runs.results if r]
-            names = [b["name"] for b in done[0]["benchmarks"]] if done else []
-            for name in names:
-                rows = [b for r in done for b in r["benchmarks"] if b["name"] == name]
-                unit = rows[0]["time_unit"]
-                real = stats.median_or_none([b["real_time"] for b in rows])
-                cpu = stats.median_or_none([b["cpu_time"] for b in rows])
-                lines.append(f"| {cell.name} | {variant.name} | {name} | {real:.3g} {unit} | "
-                             f"{cpu:.3g} {unit} |")
+    for cell, variant, done in finished_runs(experiment, table, lines):
+        names = [b["name"] for b in done[0]["benchmarks"]] if done else []
+        for name in names:
+            rows = [b for r in done for b in r["benchmarks"] if b["name"] == name]
+            unit = rows[0]["time_unit"]
+            real = stats.median_or_none([b["real_time"] for b in rows])
+            cpu = stats.median_or_none([b["cpu_time"] for b in rows])
+            lines.append(f"| {cell} | {variant} | {name} | {real:.3g} {unit} | {cpu:.3g} {unit} |")
     return lines
 
 
@@ -244,7 +243,8 @@ def plot(experiment, table, target):
     from matplotlib import pyplot
 
     width = 0.8 / len(series)
-    figure, axes = pyplot.subplots(figsize=(max(6.0, 0.6 * len(cells) * max(1, len(series) / 2)), 3.6))
+    width_inches = max(6.0, 0.6 * len(cells) * max(1, len(series) / 2))
+    figure, axes = pyplot.subplots(figsize=(width_inches, 3.6))
     for index, (name, summaries) in enumerate(series.items()):
         xs = [i + (index - (len(series) - 1) / 2) * width for i in range(len(cells))]
         heights = [1000 * (s.median or 0) for s in summaries]
@@ -252,6 +252,9 @@ def plot(experiment, table, target):
                   [1000 * ((s.high or 0) - (s.median or 0)) for s in summaries]]
         axes.bar(xs, heights, width, yerr=errors if experiment.repeats > 1 else None, label=name)
     axes.set_xticks(range(len(cells)), cells, rotation=30, ha="right", fontsize=8)
+    drawn = [1000 * s.median for ss in series.values() for s in ss if s.median]
+    if drawn and max(drawn) > 20 * min(drawn):
+        axes.set_yscale("log")  # a lost or unmasked run would flatten every other bar
     axes.set_ylabel(f"ATE {experiment.metric} (mm)")
     axes.set_title(experiment.title, fontsize=10)
     axes.legend(fontsize=8)

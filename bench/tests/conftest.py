@@ -42,10 +42,16 @@ def build(cli):
     return cli.resolve().parent.parent
 
 
-@pytest.fixture
-def tiny_experiment(tmp_path):
-    path = tmp_path / "tiny.toml"
-    path.write_text(TINY_EXPERIMENT)
+@pytest.fixture(scope="session")
+def shared():
+    """The project's shared folder; CI has it (PSPSLAM_REQUIRE_SHARED=1), so there a test that
+    needs it fails instead of skipping."""
+    path = Path(os.environ.get("PSPSLAM_SHARED", REPO.parent / "shared"))
+    if not (path / "data" / "bonn_crowd_dev").is_dir():
+        message = f"no shared folder with data/bonn_crowd_dev at {path} (set PSPSLAM_SHARED)"
+        if os.environ.get("PSPSLAM_REQUIRE_SHARED") == "1":
+            pytest.fail(message)
+        pytest.skip(message)
     return path
 
 
@@ -69,6 +75,21 @@ def section_tables(results_file, name):
         f"<!-- end experiment {name} -->", 1)[0]
     return [line for line in body.splitlines()
             if not line.startswith(("Regenerate:", "_")) and not line.startswith("![")]
+
+
+def accuracy_rows(results_file, name):
+    """The first table of experiment `name`'s section (ATE per cell and variant), as
+    {row name: [entry per variant]}."""
+    rows, started = {}, False
+    for line in section_tables(results_file, name):
+        if line.startswith("| cell |"):
+            started = True
+        elif started and line.startswith("| "):
+            cells = [cell.strip() for cell in line.strip("|").split(" | ")]
+            rows[cells[0]] = cells[1:]
+        elif started and not line.startswith("|"):
+            break
+    return rows
 
 
 def executed_runs(work):

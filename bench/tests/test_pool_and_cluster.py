@@ -82,12 +82,9 @@ class Cluster:
              str(self.scheduler_file), "--nthreads", "1", "--no-nanny", "--no-dashboard",
              "--host", "127.0.0.1"], **common) for _ in range(workers)]
         self.address = json.loads(self.scheduler_file.read_text())["address"]
-        self.wait_for(lambda: self.connected() == workers, f"{workers} workers")
-
-    def connected(self):
         import distributed
-        with distributed.Client(self.address, timeout=10) as client:
-            return len(client.scheduler_info()["workers"])
+        with distributed.Client(self.address, timeout=30) as client:
+            client.wait_for_workers(workers, timeout=60)
 
     @staticmethod
     def wait_for(condition, what, timeout=60):

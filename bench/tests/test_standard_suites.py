@@ -5,7 +5,7 @@ import shutil
 import subprocess
 
 import pytest
-from conftest import REPO, run_runner, section_tables
+from conftest import REPO, accuracy_rows, run_runner
 
 
 @pytest.fixture(scope="module")
@@ -26,25 +26,26 @@ def run_suite(name, present, stand_in, tmp_path, build):
     completed = run_runner(REPO / "bench" / "experiments" / f"{name}.toml", "--data", data,
                            "--variants", "off", "--limit-frames", "30", "--work", tmp_path / "work",
                            "--results", results, build=build)
-    rows = [line for line in section_tables(results, name) if line.startswith("| ")][1:]
-    return completed, rows
+    return completed, accuracy_rows(results, name)
 
 
 def test_tum_suite_runs_what_is_there_and_lists_the_rest(stand_in, tmp_path, build):
     present = ["rgbd_dataset_freiburg3_walking_xyz", "rgbd_dataset_freiburg3_sitting_static"]
     completed, rows = run_suite("tum_dynamic", present, stand_in, tmp_path, build)
-    run = [row for row in rows if row.startswith(("| fr3_walking_xyz ", "| fr3_sitting_static "))]
-    assert len(run) == 2 and all("/30 |" in row for row in run), rows
-    missing = [row for row in rows if "missing: " in row]
+    assert len(rows) == 8
+    for cell in ("fr3_walking_xyz", "fr3_sitting_static"):
+        assert rows[cell][0].endswith("/30"), rows
+    missing = {cell: entries[0] for cell, entries in rows.items()
+               if entries[0].startswith("missing: ")}
     assert len(missing) == 6
-    assert "| fr3_walking_rpy | missing: rgbd_dataset_freiburg3_walking_rpy not in " in "\n".join(missing)
+    assert missing["fr3_walking_rpy"].startswith(
+        "missing: rgbd_dataset_freiburg3_walking_rpy not in ")
     assert "fr3_walking_halfsphere: missing (rgbd_dataset_freiburg3_walking_halfsphere not in" \
         in completed.stderr
 
 
 def test_bonn_suite_lists_all_24_sequences(stand_in, tmp_path, build):
-    completed, rows = run_suite("bonn_dynamic", ["rgbd_bonn_crowd"], stand_in, tmp_path, build)
-    cells = [row.split(" | ")[0][2:] for row in rows]
-    assert len(cells) == 24 and "crowd" in cells and "placing_nonobstructing_box3" in cells
-    assert sum("missing: rgbd_bonn_" in row for row in rows) == 23
-    assert "/30 |" in next(row for row in rows if row.startswith("| crowd |"))
+    _, rows = run_suite("bonn_dynamic", ["rgbd_bonn_crowd"], stand_in, tmp_path, build)
+    assert len(rows) == 24 and "placing_nonobstructing_box3" in rows
+    assert sum(entries[0].startswith("missing: rgbd_bonn_") for entries in rows.values()) == 23
+    assert rows["crowd"][0].endswith("/30")

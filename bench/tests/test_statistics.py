@@ -4,7 +4,8 @@ from pspbench import stats
 
 def test_summary_of_repeats_keeps_failures_apart():
     summary = stats.summarise([0.012, None, 0.010, 0.014])
-    assert (summary.median, summary.low, summary.high, summary.worst) == (0.012, 0.010, 0.014, 0.014)
+    assert (summary.median, summary.low, summary.high) == (0.012, 0.010, 0.014)
+    assert summary.worst == 0.014
     assert (summary.runs, summary.failed) == (4, 1)
     assert abs(summary.spread - 0.004) < 1e-15
     assert stats.summarise([None]).median is None

@@ -103,7 +103,10 @@ def _ate(cli, stretch, estimate):
     reads the run's stats.json beside the file)."""
     if not estimate.exists() or estimate.stat().st_size == 0:
         return None
-    command = [cli, "-q", "eval", "--gt", stretch["ground_truth"], "--est", str(estimate), "--json"]
+    # Only the ATE is read; an RPE over consecutive frames exists for any stretch (the default
+    # one-second RPE fails on a stretch shorter than a second).
+    command = [cli, "-q", "eval", "--gt", stretch["ground_truth"], "--est", str(estimate),
+               "--json", "--rpe-delta", "1", "--rpe-unit", "f"]
     if stretch["body_to_camera"]:
         command += ["--gt-body-to-camera", stretch["body_to_camera"]]
     completed = subprocess.run(command, capture_output=True, text=True)

@@ -39,6 +39,15 @@ def local_tables(build, tmp_path_factory):
             "results": results, "experiment": experiment}
 
 
+def fresh_work(local_tables, tmp_path):
+    """An empty work folder that already has the tiny experiment's rendered sequences (keyed by
+    their recipe, so the runner takes them as made): the runs start at once."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "sequences").symlink_to(local_tables["work"] / "sequences")
+    return work
+
+
 def test_local_pool_fills_every_cell(local_tables):
     tables = local_tables["tables"]
     rows = [line for line in tables if line.startswith("| tiny_s")]
@@ -121,16 +130,16 @@ def cluster(tmp_path):
 
 @needs_dask
 def test_cluster_gives_the_local_pool_tables(local_tables, cluster, tmp_path, build):
-    results = tmp_path / "results.md"
-    run_runner(local_tables["experiment"], "--work", tmp_path / "work", "--results", results,
+    work, results = fresh_work(local_tables, tmp_path), tmp_path / "results.md"
+    run_runner(local_tables["experiment"], "--work", work, "--results", results,
                "--scheduler", cluster.address, build=build)
     assert section_tables(results, "tiny") == local_tables["tables"]
-    assert len(executed_runs(tmp_path / "work")) == RUNS
+    assert len(executed_runs(work)) == RUNS
 
 
 @needs_dask
 def test_killed_worker_still_leaves_a_complete_table(local_tables, cluster, tmp_path, build):
-    work, results = tmp_path / "work", tmp_path / "results.md"
+    work, results = fresh_work(local_tables, tmp_path), tmp_path / "results.md"
     runner = subprocess.Popen(
         [sys.executable, str(Path(__file__).parents[1] / "runner.py"), "run",
          str(local_tables["experiment"]), "--work", str(work), "--results", str(results),
@@ -152,7 +161,7 @@ def test_killed_worker_still_leaves_a_complete_table(local_tables, cluster, tmp_
 
 
 def test_killed_pool_process_still_leaves_a_complete_table(local_tables, tmp_path, build):
-    work, results = tmp_path / "work", tmp_path / "results.md"
+    work, results = fresh_work(local_tables, tmp_path), tmp_path / "results.md"
     runner = subprocess.Popen(
         [sys.executable, str(Path(__file__).parents[1] / "runner.py"), "run",
          str(local_tables["experiment"]), "--work", str(work), "--results", str(results),

@@ -270,14 +270,19 @@ def cpu_model():
     return platform.processor() or "unknown CPU"
 
 
-def commit_of(folder):
-    def git(*words):
-        return subprocess.run(["git", "-C", str(folder), *words], capture_output=True,
-                               text=True).stdout.strip()
-    commit = git("rev-parse", "--short=10", "HEAD")
-    if not commit:
-        return "unknown (not a git checkout)"
-    return commit + (" with uncommitted changes" if git("status", "--porcelain", "-uno") else "")
+def build_commit(setup):
+    """The commit the binary was built from (its --version names it), else the checkout's."""
+    version = subprocess.run([str(setup.cli), "--version"], capture_output=True, text=True).stdout
+    if "(git " in version:
+        return version.split("(git ", 1)[1].split(")", 1)[0]
+    source = build_source(setup.build) or REPO
+    commit = subprocess.run(["git", "-C", str(source), "rev-parse", "--short=10", "HEAD"],
+                            capture_output=True, text=True).stdout.strip()
+    return f"{commit} (checkout of {source})" if commit else "unknown"
+
+
+def plural(count, word):
+    return f"{count} {word}{'' if count == 1 else 's'}"
 
 
 def regenerate_command():
@@ -289,13 +294,12 @@ def regenerate_command():
     return " ".join(shlex.quote(word) for word in words)
 
 
-def provenance(args, setup, executor, counts, loads):
-    source = build_source(setup.build) or REPO
+def provenance(setup, executor, counts, loads):
     return [f"Regenerate: `{regenerate_command()}`", "",
             f"_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; build `{setup.build}` at "
-            f"commit {commit_of(source)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
+            f"commit {build_commit(setup)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
             f"{cpu_model()}, {os.cpu_count()} cores; load average {loads[0]:.1f} before, "
-            f"{loads[1]:.1f} after; {counts['runs']} runs ({counts['new']} run now, "
+            f"{loads[1]:.1f} after; {plural(counts['runs'], 'run')} ({counts['new']} run now, "
             f"{counts['reused']} reused) on the {executor}._"]
 
 
@@ -306,7 +310,9 @@ def write_report(args, experiment, setup, table, executor_text, counts, loads):
     link = None
     if report.plot(experiment, table, image):
         link = os.path.relpath(image, results_file.parent)
-    text = report.section(experiment, lines, provenance(args, setup, executor_text, counts, loads),
+    else:
+        image.unlink(missing_ok=True)  # an older run's picture would not match the tables
+    text = report.section(experiment, lines, provenance(setup, executor_text, counts, loads),
                           link)
     report.replace_section(results_file, experiment.name, text)
     log(f"wrote the '{experiment.name}' section of {results_file}")
@@ -329,8 +335,9 @@ def main(argv=None):
     setup = make_setup(parser, args, experiment)
     jobs = choose_jobs(parser, args, experiment)
     setup.work.mkdir(parents=True, exist_ok=True)
-    log(f"{experiment.name}: {len(experiment.cells)} cells × {len(experiment.variants)} variants "
-        f"× {experiment.repeats} runs; work in {setup.work}")
+    log(f"{experiment.name}: {plural(len(experiment.cells), 'cell')} × "
+        f"{plural(len(experiment.variants), 'variant')} × {plural(experiment.repeats, 'run')}; "
+        f"work in {setup.work}")
     prepared = prepare_all(parser, experiment, setup, jobs)
     table, all_jobs = expand(experiment, setup, prepared)
     for cell in experiment.cells:

@@ -224,7 +224,7 @@ def tables(experiment, table):
 
 def plot(experiment, table, target):
     """Bars of each whole cell's median ATE per variant (lowest–highest as error bars); returns
-    False when there is nothing to draw or no matplotlib to draw it."""
+    False when there are too few bars to be worth a picture, or no matplotlib to draw them."""
     if experiment.kind != "slam":
         return False
     cells = [c.name for c in experiment.cells]
@@ -233,8 +233,9 @@ def plot(experiment, table, target):
         summaries = [stats.summarise(ate_values(table[c][variant.name], c, experiment.metric))
                      for c in cells]
         series[variant.name] = summaries
-    if not any(s.median is not None for ss in series.values() for s in ss):
-        return False
+    bars = [s for ss in series.values() for s in ss if s.median is not None]
+    if len(bars) < 3:
+        return False  # the table says it all
     try:
         import matplotlib
     except ImportError:
@@ -270,7 +271,9 @@ def section(experiment, table_lines, provenance, plot_link):
     lines = [f"<!-- begin experiment {experiment.name} -->", f"## {experiment.title}", ""]
     if experiment.description:
         lines += [experiment.description, ""]
-    lines += provenance + [""] + table_lines
+    if provenance:
+        lines += provenance + [""]
+    lines += table_lines
     if plot_link:
         lines += ["", f"![{experiment.title}]({plot_link})"]
     lines += [f"<!-- end experiment {experiment.name} -->"]

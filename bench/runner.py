@@ -166,8 +166,7 @@ def make_job(experiment, cell, variant, prepared, repeat, setup, cli, cli_sha256
                          else content.digest(prepared.config_text)),
               "arguments": [a.replace(str(prepared.folder), "SEQUENCE") for a in command[1:]],
               "env": variant.env, "repeat": repeat,
-              "stretches": [[s["name"], content.file_sha256(s["ground_truth"])]
-                            for s in prepared.stretches],
+              "evaluations": sorted(s["id"] for s in prepared.stretches),
               "model_file": variant.model and content.file_sha256(REPO / variant.model)}
     return {"key": content.digest(recipe), "recipe": recipe, "kind": experiment.kind,
             "label": f"{cell.name} · {variant.name} · run {repeat + 1}", "command": command,
@@ -205,7 +204,7 @@ def expand(experiment, setup, prepared):
                 table[cell.name][variant.name] = report.CellRuns(missing=ready.reason)
                 continue
             runs = report.CellRuns(results=[None] * experiment.repeats,
-                                   rows=[s["name"] for s in ready.stretches] or [cell.name])
+                                   rows=[(s["name"], s["id"]) for s in ready.stretches])
             table[cell.name][variant.name] = runs
             for repeat in range(experiment.repeats):
                 job = make_job(experiment, cell, variant, ready, repeat, setup, cli, cli_sha256)

@@ -91,8 +91,8 @@ def measure_slam(job, attempt):
     stats = json.loads((run / "stats.json").read_text())
     files = {"online": "trajectory.txt", "final": "trajectory_refined.txt",
              "keyframes": "keyframes.txt"}
-    evaluations = {stretch["name"]: {label: _ate(job["command"][0], stretch, run / name)
-                                     for label, name in files.items()}
+    evaluations = {stretch["id"]: {label: _ate(job["command"][0], stretch, run / name)
+                                   for label, name in files.items()}
                    for stretch in job["stretches"]}
     return {"stats": stats, "evaluations": evaluations}
 

@@ -24,7 +24,8 @@ class CellRuns:
     """One cell under one variant: its results by repeat (None = failed), or why it is missing."""
     missing: str | None = None
     results: list = field(default_factory=list)
-    rows: list = field(default_factory=list)  # evaluation rows (the cell, then its stretches)
+    # (name, evaluation id) of the rows: the whole cell, then its stretches
+    rows: list = field(default_factory=list)
 
 
 def millimetres(value):
@@ -37,20 +38,22 @@ def signed_millimetres(value):
 
 def ate_values(runs, row, which):
     """The ATE (m) of `which` file on evaluation row `row`, per repeat (None = no result)."""
+    evaluation = dict(runs.rows).get(row)
     values = []
     for result in runs.results:
-        ate = result and result["evaluations"].get(row, {}).get(which)
+        ate = result and result["evaluations"].get(evaluation, {}).get(which)
         values.append(ate["rmse"] if ate else None)
     return values
 
 
 def tracked_text(runs, row, whole_cell):
     """Poses evaluated (the fewest over repeats) / frames processed."""
+    evaluation = dict(runs.rows).get(row)
     poses, frames = [], []
     for result in runs.results:
         if result is None:
             continue
-        online = result["evaluations"].get(row, {}).get("online")
+        online = result["evaluations"].get(evaluation, {}).get("online")
         poses.append(online["poses"] if online else 0)
         frames.append(result["stats"]["frames"])
     if not poses:
@@ -73,7 +76,8 @@ def evaluation_rows(experiment, table):
     """(cell name, row name, is the whole cell) in table order; a missing cell is one row."""
     rows = []
     for cell in experiment.cells:
-        names = next((runs.rows for runs in table[cell.name].values() if runs.rows), [cell.name])
+        names = next(([name for name, _ in runs.rows] for runs in table[cell.name].values()
+                      if runs.rows), [cell.name])
         rows += [(cell.name, name, name == cell.name) for name in names]
     return rows
 

@@ -232,15 +232,24 @@ def _stretches(cell, folder, identity, setup):
         return []
     body = folder / "body_to_camera.txt"
     body = str(body) if body.exists() else None
-    stretches = [{"name": cell.name, "ground_truth": str(ground_truth), "body_to_camera": body}]
+    stretches = [_evaluation(cell.name, ground_truth, body)]
     for stretch in cell.stretches:
         part = content.digest({"stretch": [stretch.first, stretch.last], "source": identity})
         target = setup.work / "sequences" / f"stretch-{part[:16]}.txt"
         if not target.exists():
             _write_stretch_ground_truth(folder, target, stretch.first, stretch.last)
-        stretches.append({"name": f"{cell.name}:{stretch.name}", "ground_truth": str(target),
-                          "body_to_camera": body})
+        stretches.append(_evaluation(f"{cell.name}:{stretch.name}", target, body))
     return stretches
+
+
+def _evaluation(name, ground_truth, body_to_camera):
+    """One evaluation of a run: a name for the tables and an id by content (the ground truth and
+    the body-to-camera transform), under which the result keeps it: another experiment's cell
+    scored on the same ground truth reads the same evaluation."""
+    identity = content.digest([content.file_sha256(ground_truth),
+                               body_to_camera and content.file_sha256(body_to_camera)])
+    return {"name": name, "id": identity[:16], "ground_truth": str(ground_truth),
+            "body_to_camera": body_to_camera}
 
 
 def _write_stretch_ground_truth(folder, target, first, last):

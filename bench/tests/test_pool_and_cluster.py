@@ -58,7 +58,8 @@ def test_local_pool_fills_every_cell(local_tables):
     assert len(results) == RUNS
     for path in results:
         result = json.loads(path.read_text())
-        assert result["evaluations"][result["label"].split(" · ")[0]]["online"]["poses"] > 0
+        whole_cell = next(iter(result["evaluations"].values()))
+        assert whole_cell["online"]["poses"] > 0
 
 
 def test_second_invocation_reruns_nothing(local_tables, build):

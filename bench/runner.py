@@ -112,7 +112,7 @@ def build_source(build):
     return None
 
 
-def make_setup(parser, args, experiment):
+def make_setup(parser, args):
     build = Path(args.build).resolve()
     cli = build / "apps" / "pspslam"
     if not os.access(cli, os.X_OK):
@@ -164,7 +164,8 @@ def make_job(experiment, cell, variant, prepared, repeat, setup, cli, cli_sha256
               "models_sha256": setup.models_sha256, "data": prepared.identity,
               "config": (None if prepared.config_text is None
                          else content.digest(prepared.config_text)),
-              "arguments": [a.replace(str(prepared.folder), "SEQUENCE") for a in command[1:]],
+              "arguments": [a.replace(str(prepared.folder), "SEQUENCE").replace(str(REPO), "REPO")
+                            for a in command[1:]],
               "env": variant.env, "repeat": repeat,
               "evaluations": sorted(s["id"] for s in prepared.stretches),
               "model_file": variant.model and content.file_sha256(REPO / variant.model)}
@@ -189,6 +190,9 @@ def prepare_all(parser, experiment, setup, jobs):
         except experiments.ExperimentError as error:
             print(f"runner.py: {error}", file=sys.stderr)
             sys.exit(2)
+        except RuntimeError as error:  # a sequence that could not be made (synth, re-encoding)
+            print(f"runner.py: {error}", file=sys.stderr)
+            sys.exit(1)
     return {(cell.name, variant.name): (p, clis[variant.name])
             for (cell, variant), p in zip(pairs, prepared)}
 
@@ -331,7 +335,7 @@ def choose_jobs(parser, args, experiment):
 def main(argv=None):
     parser, args = parse_arguments(argv)
     experiment = load_experiment(parser, args)
-    setup = make_setup(parser, args, experiment)
+    setup = make_setup(parser, args)
     jobs = choose_jobs(parser, args, experiment)
     setup.work.mkdir(parents=True, exist_ok=True)
     log(f"{experiment.name}: {plural(len(experiment.cells), 'cell')} × "

@@ -62,7 +62,10 @@ def prepare(experiment, cell, variant, setup):
     if experiment.kind == "segment":
         return _image_split(experiment, cell, folder, identity, setup)
     if cell.reencode_jpeg:
-        folder, identity = _reencoded(folder, identity, cell.reencode_jpeg, setup)
+        tool = setup.build / "bench" / "reencode_colour"
+        if not os.access(tool, os.X_OK):
+            return Missing(f"{tool} is not built (cmake --build BUILD --target reencode_colour)")
+        folder, identity = _reencoded(folder, identity, cell.reencode_jpeg, tool, setup)
     if cell.start:
         folder, identity = _sliced(folder, identity, cell.start, setup)
     config_text = _config_text(experiment, cell, variant, folder, setup)
@@ -121,10 +124,7 @@ def _synthetic(cell, variant, setup):
     return target, identity
 
 
-def _reencoded(folder, identity, quality, setup):
-    tool = setup.build / "bench" / "reencode_colour"
-    if not os.access(tool, os.X_OK):
-        raise ExperimentError(f"{tool} is not built (cmake --build BUILD --target reencode_colour)")
+def _reencoded(folder, identity, quality, tool, setup):
     identity = content.digest({"jpeg": quality, "source": identity,
                                "tool_sha256": content.file_sha256(tool)})
     target = setup.work / "sequences" / f"jpeg{quality}-{identity[:16]}"

@@ -297,13 +297,30 @@ def regenerate_command():
     return " ".join(shlex.quote(word) for word in words)
 
 
-def provenance(setup, executor, counts, loads):
+def when_made(table):
+    """When the results were made and at what load: reused results may be older than the
+    section."""
+    results = [r for cell in table.values() for runs in cell.values() for r in runs.results if r]
+    if not results:
+        return ""
+    stamps = sorted(r["finished_utc"][:16].replace("T", " ") for r in results)
+    first, last = stamps[0], stamps[-1]
+    if first != last:
+        last = last[11:] if last[:10] == first[:10] else last  # the time alone on the same day
+    span = first if first == last else f"{first} to {last}"
+    loads = [r["load_at_start"][0] for r in results]
+    return (f"runs finished {span} UTC, load average {min(loads):.1f}–{max(loads):.1f} at their "
+            "start; ")
+
+
+def provenance(setup, executor, counts, loads, table):
     return [f"Regenerate: `{regenerate_command()}`", "",
             f"_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; build `{setup.build}` at "
             f"commit {build_commit(setup)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
-            f"{cpu_model()}, {os.cpu_count()} cores; load average {loads[0]:.1f} before, "
-            f"{loads[1]:.1f} after; {plural(counts['runs'], 'run')} ({counts['new']} run now, "
-            f"{counts['reused']} reused) on the {executor}._"]
+            f"{cpu_model()}, {os.cpu_count()} cores; {when_made(table)}load average "
+            f"{loads[0]:.1f} before, {loads[1]:.1f} after this invocation; "
+            f"{plural(counts['runs'], 'run')} ({counts['new']} run now, {counts['reused']} "
+            f"reused) on the {executor}._"]
 
 
 def write_report(args, experiment, setup, table, executor_text, counts, loads):
@@ -315,7 +332,7 @@ def write_report(args, experiment, setup, table, executor_text, counts, loads):
         link = os.path.relpath(image, results_file.parent)
     else:
         image.unlink(missing_ok=True)  # an older run's picture would not match the tables
-    text = report.section(experiment, lines, provenance(setup, executor_text, counts, loads),
+    text = report.section(experiment, lines, provenance(setup, executor_text, counts, loads, table),
                           link)
     report.replace_section(results_file, experiment.name, text)
     log(f"wrote the '{experiment.name}' section of {results_file}")

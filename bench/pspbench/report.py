@@ -33,7 +33,8 @@ def millimetres(value):
 
 
 def signed_millimetres(value):
-    return "—" if value is None else f"{value * 1000:+.1f}"
+    """A difference in mm, to 0.01 mm: a tenth would show a win of 0.04 mm as -0.0."""
+    return "—" if value is None else f"{value * 1000:+.2f}"
 
 
 def ate_values(runs, row, which):
@@ -107,9 +108,10 @@ def slam_tables(experiment, table):
 
 
 def comparisons_of(experiment, table, variant):
-    """Per evaluation row: the variant against the base on the experiment's metric."""
+    """Per evaluation row: (row, is the whole cell, the variant against the base on the
+    experiment's metric)."""
     comparisons = []
-    for cell, row, _ in evaluation_rows(experiment, table):
+    for cell, row, whole in evaluation_rows(experiment, table):
         base_runs, runs = table[cell][experiment.base], table[cell][variant]
         if base_runs.missing or runs.missing:
             continue
@@ -121,7 +123,7 @@ def comparisons_of(experiment, table, variant):
             if jitter.median is not None and base.median is not None:
                 extra = abs(jitter.median - base.median)
         measured = stats.summarise(ate_values(runs, row, experiment.metric))
-        comparisons.append((row, stats.compare(base, measured, extra)))
+        comparisons.append((row, whole, stats.compare(base, measured, extra)))
     return comparisons
 
 
@@ -131,14 +133,15 @@ def paired_tables(experiment, table):
     if not others:
         return []
     lines = [f"Paired against the base `{experiment.base}` on the {experiment.metric} ATE, cell "
-             "by cell (a difference within the cell's spread is a tie):", "",
+             "by cell (a difference within the cell's spread is a tie; stretches are parts of "
+             "their cell and not counted again):", "",
              "| variant | wins | losses | ties | lost | median Δ (mm) | median ratio | "
              "worst Δ (mm) |", "|---|---|---|---|---|---|---|---|"]
     per_cell = {}
     for variant in others:
         comparisons = comparisons_of(experiment, table, variant)
-        per_cell[variant] = dict(comparisons)
-        t = stats.tally([c for _, c in comparisons])
+        per_cell[variant] = {row: c for row, _, c in comparisons}
+        t = stats.tally([c for _, whole, c in comparisons if whole])
         ratio = "—" if t.median_ratio is None else f"{t.median_ratio:.2f}"
         lines.append(f"| {variant} | {t.wins} | {t.losses} | {t.ties} | {t.lost} | "
                      f"{signed_millimetres(t.median_delta)} | {ratio} | "

@@ -101,9 +101,37 @@ def slam_tables(experiment, table):
     lines = [f"ATE online / final (mm) · poses evaluated / frames; median over "
              f"{experiment.repeats} run{'s' if experiment.repeats > 1 else ''}"
              f"{' [lowest–highest]' if experiment.repeats > 1 else ''}.", ""] + lines
+    lines += [""] + summary_table(experiment, table)
     lines += [""] + paired_tables(experiment, table)
     if experiment.columns:
         lines += [""] + column_table(experiment, table)
+    return lines
+
+
+def summary_table(experiment, table):
+    """Each variant over the whole cells (stretches left out): median, lowest and highest of the
+    cells' medians, and in how many cells the final trajectory is not worse than the online one."""
+    lines = ["Over the cells (each cell's median; stretches left out):", "",
+             "| variant | cells | online median [lowest–highest] | final median [lowest–highest] "
+             "| final ≤ online |", "|---|---|---|---|---|"]
+    for variant in experiment.variants:
+        medians = {"online": [], "final": []}
+        not_worse = 0
+        for cell in experiment.cells:
+            runs = table[cell.name][variant.name]
+            if runs.missing:
+                continue
+            online, final = (stats.summarise(ate_values(runs, cell.name, which)).median
+                             for which in ("online", "final"))
+            medians["online"].append(online)
+            medians["final"].append(final)
+            not_worse += online is not None and final is not None and final <= online
+        spread = {which: stats.summarise(values) for which, values in medians.items()}
+        text = {which: "—" if s.median is None else
+                f"{millimetres(s.median)} [{millimetres(s.low)}–{millimetres(s.high)}]"
+                for which, s in spread.items()}
+        lines.append(f"| {variant.name} | {len(medians['online'])} | {text['online']} | "
+                     f"{text['final']} | {not_worse} of {len(medians['online'])} |")
     return lines
 
 

@@ -275,7 +275,11 @@ def cpu_model():
 
 def build_commit(setup):
     """The commit the binary was built from (its --version names it), else the checkout's."""
-    version = subprocess.run([str(setup.cli), "--version"], capture_output=True, text=True).stdout
+    try:
+        version = subprocess.run([str(setup.cli), "--version"], capture_output=True,
+                                 text=True).stdout
+    except OSError:  # the binary went away during the runs (a rebuild)
+        version = ""
     if "(git " in version:
         return version.split("(git ", 1)[1].split(")", 1)[0]
     source = build_source(setup.build) or REPO

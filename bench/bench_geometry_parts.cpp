@@ -1,6 +1,6 @@
 // Google Benchmark of the geometry module's parts on one synthetic frame (640x480, 1000
 // candidates, 5 references): compensated homography, multi-view test, both search strategies,
-// region growing, whole stage. Numbers in docs/geometry.md.
+// region growing, whole stage. Run by bench/experiments/geometry_timing.toml.
 #include <benchmark/benchmark.h>
 
 #include <random>

@@ -1,6 +1,7 @@
 // Re-encodes every colour image of a TUM-layout sequence as JPEG of a given quality, for the
-// accuracy panel's re-encoding cell (bench/accuracy_panel.py): the same frames, other compression
-// artefacts, so a change that only fits one encoding of the clip shows up as a loss there.
+// accuracy panel's re-encoding cell (bench/experiments/accuracy_panel.toml): the same frames,
+// other compression artefacts, so a change that only fits one encoding of the clip shows up as a
+// loss there.
 //   reencode_colour IN_SEQUENCE OUT_SEQUENCE QUALITY
 // OUT gets rgb/ (JPEG, file names kept so rgb.txt stays valid) and links to everything else of IN
 // (depth/, depth.txt, rgb.txt, groundtruth.txt, ...): nothing but the colour pixels changes.

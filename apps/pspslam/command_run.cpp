@@ -19,6 +19,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -41,6 +42,7 @@
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
+#include "pspslam/semantic/semantic_delay.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/sequence_runner.h"
 #include "pspslam/viewer/live_viewer.h"
@@ -156,6 +158,8 @@ struct RunFlags {
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   int segment_every = 1;
+  std::string semantic_delay;  // empty: none (fault injection)
+  std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
   int local_ba_keyframes = -1;       // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
@@ -234,6 +238,11 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   dynamic.realtime = flags.realtime;
   dynamic.semantic.mask_dilation_px = flags.mask_margin;
   dynamic.segment_every = flags.segment_every;
+  if (!flags.semantic_delay.empty()) {
+    dynamic.semantic.injected_delay =
+        parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
+    dynamic.semantic.injected_delay.seed = flags.semantic_delay_seed;
+  }
   dynamic.culling.min_dynamic_hits = flags.cull_hits;
   system.place.relocalization = !flags.no_relocalization;
   if (!flags.load_map.empty()) {
@@ -390,6 +399,25 @@ Command add_run_command(CLI::App& root) {
                   "segment every n-th frame; the frames between use the newest mask, moved "
                   "with the camera by the frame-to-frame homographies")
       ->check(in_range(1, 30))
+      ->capture_default_str();
+  CLI::Option* semantic_delay =
+      app->add_option("--semantic-delay-ms", flags->semantic_delay,
+                      "fault injection: MS or random:MIN:MAX milliseconds of extra wait after each "
+                      "segmentation, as if the network were that much slower (reproduces a "
+                      "network that falls behind the camera)")
+          ->check(CLI::Validator(
+              [](std::string& value) {
+                try {
+                  parse_semantic_delay(value, "--semantic-delay-ms");
+                  return std::string();
+                } catch (const Error& e) {
+                  return std::string(e.what());
+                }
+              },
+              "MS|random:MIN:MAX"));
+  app->add_option("--semantic-delay-seed", flags->semantic_delay_seed,
+                  "seed of the random:MIN:MAX delays (the same seed draws the same delays)")
+      ->needs(semantic_delay)
       ->capture_default_str();
   app->add_option("--semantic-masks", flags->semantic_masks,
                   "read each frame's semantic mask from this folder instead of running the "

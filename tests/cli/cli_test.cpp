@@ -537,6 +537,17 @@ TEST(CliRun, FlagValuesAreCheckedBeforeAnyWork) {
   EXPECT_EQ(r.output,
             "error: pspslam run: --blackout: --blackout expects FROM:COUNT (frame index and a "
             "positive number of frames), got '3' (see 'pspslam run --help')\n");
+  r = pspslam(run + "--semantic-delay-ms random:300:100");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --semantic-delay-ms: --semantic-delay-ms expects MS or "
+            "random:MIN:MAX (whole milliseconds, 0-10000, MIN <= MAX), got 'random:300:100' "
+            "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--semantic-delay-seed 4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --semantic-delay-seed requires --semantic-delay-ms (see 'pspslam "
+            "run --help')\n");
   r = pspslam(run + "--max-frames -1");
   EXPECT_EQ(r.output,
             "error: pspslam run: --max-frames: must be an integer in [0, 1000000000], got '-1' "

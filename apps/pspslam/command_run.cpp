@@ -56,15 +56,13 @@ constexpr int kInterruptedExit = 130;
 constexpr int kNeverStartedExit = 3;
 // --camera: the camera stopped delivering (unplugged); the outputs hold every frame so far.
 constexpr int kCameraLostExit = 4;
-// Nice increment of the background threads in live runs (--background-nice; issue #18 item 1:
-// measured in docs/benchmarks.md "Real time on two cores").
+// Nice increment of the background threads in live runs (--background-nice; measured in
+// docs/benchmarks.md "Real time on two cores").
 constexpr int kLiveBackgroundNice = 10;
 // Local BA window of live runs (--local-ba-keyframes): the best 10 covisible keyframes. On two
-// cores the whole covisible set (35 keyframes, 13k observations, ~0.2 s in a small room) leaves
-// local BA cut short; with 10 it costs a third less and real-time runs on bonn_crowd_dev beat the
-// whole window online in 8 of 8 pairs. Offline runs keep ORB-SLAM2's whole window: on the
-// accuracy panel the capped one lost the final trajectory (docs/benchmarks.md, "The local BA
-// window").
+// cores the whole covisible set of a small room leaves local BA cut short, and the capped window
+// keeps up. Offline runs keep ORB-SLAM2's whole window, which gives the better final trajectory
+// (docs/benchmarks.md, "The local BA window").
 constexpr int kLiveLocalBaKeyframes = 10;
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
@@ -158,6 +156,10 @@ struct RunFlags {
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   int segment_every = 1;
+  std::string semantic_pace = "on";
+  std::string smaller_model;  // empty: the shipped smaller input when --model is the shipped one
+  std::string stale_masks = "flow";
+  std::string mover_guard = "off";
   std::string semantic_delay;  // empty: none (fault injection)
   std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
@@ -238,6 +240,15 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   dynamic.realtime = flags.realtime;
   dynamic.semantic.mask_dilation_px = flags.mask_margin;
   dynamic.segment_every = flags.segment_every;
+  dynamic.keep_pace = flags.semantic_pace == "on";
+  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
+  if (!flags.smaller_model.empty())
+    dynamic.smaller_model = flags.smaller_model;
+  else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
+    dynamic.smaller_model = shipped_smaller;
+  system.tracker.mover_guard.enabled = flags.mover_guard == "on";
+  dynamic.stale_masks =
+      flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
   if (!flags.semantic_delay.empty()) {
     dynamic.semantic.injected_delay =
         parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
@@ -400,6 +411,31 @@ Command add_run_command(CLI::App& root) {
                   "with the camera by the frame-to-frame homographies")
       ->check(in_range(1, 30))
       ->capture_default_str();
+  app->add_option("--semantic-pace", flags->semantic_pace,
+                  "with --realtime: when segmentation falls behind the camera, step down by "
+                  "itself to the smaller network input (--smaller-model), then to segmenting "
+                  "every 2nd or 3rd frame, and back up when there is room (off: one network on "
+                  "every frame it can take)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--smaller-model", flags->smaller_model,
+                  "the smaller segmentation model --semantic-pace steps down to (default: the "
+                  "shipped models/pspnet/pspnet_288x192.yaml when --model is the shipped one, "
+                  "else none: only sparser frames)")
+      ->check(CLI::ExistingFile);
+  app->add_option("--stale-masks", flags->stale_masks,
+                  "with --realtime, how an older mask is brought into the frame: flow = each "
+                  "person moves by the optical flow inside it and the mask grows with its age, "
+                  "and keypoints near a mask more than 2 frames old get the geometry test; "
+                  "homography = moved with the camera only")
+      ->check(CLI::IsMember({"flow", "homography"}))
+      ->capture_default_str();
+  app->add_option("--mover-guard", flags->mover_guard,
+                  "experimental: when a frame's inliers drop and its pose jumps off the "
+                  "constant-velocity prediction (tracking following a crowd), hold the "
+                  "prediction for up to 3 frames")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   CLI::Option* semantic_delay =
       app->add_option("--semantic-delay-ms", flags->semantic_delay,
                       "fault injection: MS or random:MIN:MAX milliseconds of extra wait after each "
@@ -444,7 +480,7 @@ Command add_run_command(CLI::App& root) {
   app->add_flag("--due-keyframes", flags->due_keyframes,
                 "also make a keyframe once a second has passed since the last one, whatever "
                 "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "
-                "off by default: mixed on the accuracy panel, docs/benchmarks.md #15 item 5)");
+                "off by default: mixed on the accuracy panel, docs/benchmarks.md)");
   app->add_option("--motion-prior", flags->motion_prior,
                   "MM DEG: optimise each frame tracked with the motion model with its "
                   "constant-velocity prediction as a prior of these σs (translation mm, rotation "

@@ -591,8 +591,49 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
   EXPECT_EQ(stats["frames"], 3);
 }
 
+// stats.json `live_masks`: a live run says how many frames ran on a stale mask and, per level of
+// the semantic pace (the shipped network, the smaller one, then every 2nd and 3rd frame), how
+// many frames ran while the thread was there; the frames add up to the frames with a level. A
+// deterministic run has no such member and never steps down. An injected delay makes stale
+// masks likely, but how many depends on the machine: only the bookkeeping is checked.
+TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
+  const auto dir = testing::make_temp_dir("cli_live_masks");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 2 --seed 4");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const std::string run = "run --sequence " + (dir / "seq").string() +
+                          " --dynamic full --loop-closing off --semantic-delay-ms 100 --out ";
+  const Result live = pspslam(run + (dir / "live").string() + " --realtime");
+  ASSERT_EQ(live.status, 0) << live.output;
+  EXPECT_TRUE(contains(live.output, "live masks:   ")) << live.output;
+  EXPECT_TRUE(contains(live.output, "semantic pace: frames at each level: 0 pspnet.yaml ("))
+      << live.output;
+  std::ifstream in(dir / "live" / "stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  const nlohmann::json& masks = stats["live_masks"];
+  EXPECT_EQ(masks["stale_after_frames"].get<int>(), 2);
+  EXPECT_EQ(masks["stale_masks"].get<std::string>(), "flow");
+  EXPECT_LE(masks["frames_on_stale_mask"].get<int>(), stats["frames"].get<int>());
+  const nlohmann::json& levels = masks["pace"]["levels"];
+  ASSERT_EQ(levels.size(), 4u);
+  EXPECT_EQ(levels[1]["network"].get<std::string>(), "pspnet_288x192.yaml (288x192)");
+  EXPECT_EQ(levels[3]["stride"].get<int>(), 3);
+  int frames = 0;
+  for (const nlohmann::json& level : levels) frames += level["frames"].get<int>();
+  EXPECT_GT(frames, 0);
+  EXPECT_LE(frames, stats["frames"].get<int>());
+  EXPECT_EQ(masks["pace"]["frames_stepped_down"].get<int>(),
+            stats["frames"].get<int>() - levels[0]["frames"].get<int>());
+
+  const Result deterministic = pspslam(run + (dir / "deterministic").string());
+  ASSERT_EQ(deterministic.status, 0) << deterministic.output;
+  EXPECT_FALSE(contains(deterministic.output, "live masks:")) << deterministic.output;
+  std::ifstream in_deterministic(dir / "deterministic" / "stats.json");
+  EXPECT_FALSE(nlohmann::json::parse(in_deterministic).contains("live_masks"));
+}
+
 // stats.json `latency`: with --realtime every processed frame has its arrival-to-pose time
-// (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
+// (the real-time figures); a deterministic run has no arrival times and reports none.
 // `scheduling`: a real-time run lowers the background threads (nice 10), gives OpenCV one thread
 // and local BA the best 10 covisible keyframes; a deterministic run changes none of them (the
 // whole covisible window: 0); --background-nice / --opencv-threads / --local-ba-keyframes

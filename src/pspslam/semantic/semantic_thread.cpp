@@ -144,6 +144,7 @@ void SemanticThread::publish(std::shared_ptr<SemanticResult> result) {
   if (pace_) {
     pace_->observe(result->inference_ms);
     stride_.store(pace_->current().stride, std::memory_order_relaxed);
+    level_.store(pace_->level(), std::memory_order_relaxed);
   }
   {
     std::lock_guard lock(mutex_);

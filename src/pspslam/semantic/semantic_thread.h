@@ -86,6 +86,8 @@ class SemanticThread {
   SemanticStats stats() const;
   // Frames the caller should skip between submissions: the pace's stride (1 without a pace).
   int stride() const { return stride_.load(std::memory_order_relaxed); }
+  // The pace's level now (0 without a pace).
+  int level() const { return level_.load(std::memory_order_relaxed); }
 
  private:
   struct Pending {
@@ -105,6 +107,7 @@ class SemanticThread {
   std::optional<SemanticPace> pace_;  // touched by the worker only, stats under mutex_
   SemanticDelayDraw delay_;
   std::atomic<int> stride_{1};
+  std::atomic<int> level_{0};
   std::vector<int> dynamic_ids_;
   int dilation_px_;
   size_t queue_size_;

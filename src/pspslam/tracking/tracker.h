@@ -13,6 +13,7 @@
 #include "pspslam/tracking/keyframe_policy.h"
 #include "pspslam/tracking/local_map.h"
 #include "pspslam/tracking/map_initializer.h"
+#include "pspslam/tracking/mover_guard.h"
 #include "pspslam/tracking/relocalizer.h"
 
 namespace pspslam {
@@ -53,6 +54,8 @@ struct TrackerOptions {
   // (docs/benchmarks.md, "Rolling shutter").
   double rotation_rate_sigma = 0.03;
   RelocalizerOptions relocalizer;
+  // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).
+  MoverGuardOptions mover_guard;
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
@@ -97,6 +100,9 @@ struct TrackResult {
   // Tracking was lost while the map was this young (MapInitializer::restart_when_lost_below):
   // the caller stops local mapping's work and calls Tracker::restart().
   bool restart_due = false;
+  // The pose is the motion model's prediction: the optimised one followed a moving cluster
+  // (MoverGuard).
+  bool pose_held = false;
 };
 
 // Tracking of each frame (ORB-SLAM2 semantics): map initialisation by the sensor's
@@ -167,6 +173,8 @@ class Tracker {
   bool relocalize(Frame& frame);
   bool track_local_map(Frame& frame);
   void maybe_insert_keyframe(Frame& frame, TrackResult& result);
+  // After a motion-model frame's pose is final: the prediction instead when MoverGuard says so.
+  void guard_against_movers(Frame& frame, TrackResult& result);
 
   // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
   int optimize_frame_pose(Frame& frame);
@@ -186,6 +194,9 @@ class Tracker {
   // The constant-velocity prediction of the frame being tracked, as a prior for its pose-only
   // optimisations (set only when it was tracked with the motion model and a prior is configured).
   std::optional<PosePrior> motion_prior_;
+  // The constant-velocity prediction of the frame being tracked with the motion model.
+  std::optional<Pose> predicted_pose_;
+  MoverGuard mover_guard_;
   std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
   std::shared_ptr<KeyFrame> reference_keyframe_;
   std::uint64_t last_keyframe_frame_id_ = 0;

@@ -158,8 +158,10 @@ struct RunFlags {
   int segment_every = 1;
   std::string semantic_pace = "on";
   std::string smaller_model;  // empty: the shipped smaller input when --model is the shipped one
-  std::string stale_masks = "flow";
+  std::string stale_masks = "homography";
+  int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
   std::string mover_guard = "off";
+  std::string stale_geometry = "on";
   std::string semantic_delay;  // empty: none (fault injection)
   std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
@@ -247,6 +249,8 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
     dynamic.smaller_model = shipped_smaller;
   system.tracker.mover_guard.enabled = flags.mover_guard == "on";
+  dynamic.tighten_geometry = flags.stale_geometry == "on";
+  dynamic.propagation.max_growth_px = flags.stale_mask_growth;
   dynamic.stale_masks =
       flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
   if (!flags.semantic_delay.empty()) {
@@ -426,9 +430,19 @@ Command add_run_command(CLI::App& root) {
   app->add_option("--stale-masks", flags->stale_masks,
                   "with --realtime, how an older mask is brought into the frame: flow = each "
                   "person moves by the optical flow inside it and the mask grows with its age, "
-                  "and keypoints near a mask more than 2 frames old get the geometry test; "
-                  "homography = moved with the camera only")
+                  "and keypoints near a mask more than 2 frames old get the geometry test "
+                  "(experimental: it can leave a crowd too few static keypoints); homography = "
+                  "moved with the camera only")
       ->check(CLI::IsMember({"flow", "homography"}))
+      ->capture_default_str();
+  app->add_option("--stale-mask-growth", flags->stale_mask_growth,
+                  "with --stale-masks flow: the most pixels a moved mask grows by for its age")
+      ->check(in_range(0, 200))
+      ->capture_default_str();
+  app->add_option("--stale-geometry", flags->stale_geometry,
+                  "with --realtime and --stale-masks flow: while the mask is more than 2 frames "
+                  "old, every keypoint in a band around it gets the multi-view geometry test")
+      ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   app->add_option("--mover-guard", flags->mover_guard,
                   "experimental: when a frame's inliers drop and its pose jumps off the "

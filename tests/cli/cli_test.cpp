@@ -612,7 +612,7 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   const nlohmann::json stats = nlohmann::json::parse(in);
   const nlohmann::json& masks = stats["live_masks"];
   EXPECT_EQ(masks["stale_after_frames"].get<int>(), 2);
-  EXPECT_EQ(masks["stale_masks"].get<std::string>(), "flow");
+  EXPECT_EQ(masks["stale_masks"].get<std::string>(), "homography");
   EXPECT_LE(masks["frames_on_stale_mask"].get<int>(), stats["frames"].get<int>());
   const nlohmann::json& levels = masks["pace"]["levels"];
   ASSERT_EQ(levels.size(), 4u);

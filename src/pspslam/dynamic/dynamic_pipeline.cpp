@@ -170,7 +170,7 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, std::span<const float
     // the mask needs no full-image warp here.
     if (!watch_mask_.empty()) {
       // A stale mask: the prior is already in this frame (no homography to map back through).
-      input.previous_dynamic_mask = stale_prior_mask();
+      input.previous_dynamic_mask = watch_mask_;
       report.geometry_tightened = true;
     } else if (!previous_mask_.empty() && H_previous_to_current_) {
       input.previous_dynamic_mask = previous_mask_;
@@ -298,28 +298,17 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
 
 cv::Mat DynamicPipeline::propagate_mask(const SemanticResult& result, DynamicReport& report) {
   const bool stale = current_id_ - result.frame_id > options_.stale_mask_frames;
-  PropagatedMask moved =
-      propagator_->propagate(result.dynamic_mask, result.frame_id, current_id_, chain_, stale);
+  PropagatedMask moved = propagator_->propagate(result.dynamic_mask, result.frame_id, current_id_,
+                                                chain_, stale && options_.tighten_geometry);
   report.mask_age_frames = moved.age_frames;
   report.mask_warped = moved.age_frames > 0;
   report.mask_moved_by_flow = moved.moved_by_flow > 0;
   report.mask_growth_px = moved.growth_px;
-  if (stale) watch_mask_ = std::move(moved.watch);
+  if (stale && options_.tighten_geometry) watch_mask_ = std::move(moved.watch);
   // Map points are culled on the people's moved outline: the growth is a margin of doubt, and
   // static points inside it must not be erased for it.
   cull_mask_ = std::move(moved.moved);
   return moved.mask;
-}
-
-cv::Mat DynamicPipeline::stale_prior_mask() const {
-  if (previous_mask_.empty()) return watch_mask_;
-  cv::Mat previous =
-      H_previous_to_current_
-          ? warp_to_current(previous_mask_, *H_previous_to_current_, watch_mask_.size(), true)
-          : previous_mask_;
-  cv::Mat prior;
-  cv::bitwise_or(watch_mask_, previous, prior);
-  return prior;
 }
 
 // The geometry stage's reference pool: the depth images of this run's newest keyframes, or in

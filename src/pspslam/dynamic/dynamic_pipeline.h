@@ -69,11 +69,17 @@ struct DynamicOptions {
   std::filesystem::path smaller_model;
   int pace_max_stride = 3;
   double frame_period_ms = 1000.0 / 30.0;  // the camera's (the runner sets it from the config)
-  StaleMaskPolicy stale_masks = StaleMaskPolicy::flow;
+  // Homography by default: with flow, the grown masks of a crowd left too few static keypoints
+  // and live runs under injected delays lost frames that the homography policy kept.
+  StaleMaskPolicy stale_masks = StaleMaskPolicy::homography;
   MaskPropagationParams propagation;
   // A mask more than this many frames old is stale: the geometry stage then tests every
   // keypoint near it (MaskPropagationParams::watch_band_px), and the summary counts the frame.
   int stale_mask_frames = 2;
+  // While the mask is stale, the geometry stage's prior is the band around the moved mask
+  // instead of the previous frame's fused mask. Not the fused mask as well: it holds last
+  // frame's grown mask and regions, and a prior that includes its own growth widens each frame.
+  bool tighten_geometry = true;
 };
 
 // What became of one extracted keypoint (pictures of a run: `pspslam run --save-overlays`).
@@ -194,9 +200,6 @@ class DynamicPipeline {
   cv::Mat semantic_mask(DynamicReport& report);
   // A live run's older mask moved into the current frame (StaleMaskPolicy::flow).
   cv::Mat propagate_mask(const SemanticResult& result, DynamicReport& report);
-  // The geometry stage's prior mask while the semantic mask is stale: the keypoints around it
-  // and inside the previous frame's dynamic mask get the multi-view test first.
-  cv::Mat stale_prior_mask() const;
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;
 

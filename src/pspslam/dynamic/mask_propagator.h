@@ -15,7 +15,8 @@ struct MaskPropagationParams {
   // How fast the parts of a person may move beyond what the flow measured (limbs, turns, a
   // change of pace), m/s: the mask grows by this speed times its age, seen at the person's depth.
   double residual_speed_mps = 0.5;
-  int max_growth_px = 40;
+  // A crowd's masks grown much further left too few static keypoints: tracking was lost.
+  int max_growth_px = 12;
   // Around the grown mask, keypoints this many pixels further out are all given the multi-view
   // test while the mask is stale (DynamicOptions::stale_mask_frames).
   int watch_band_px = 24;

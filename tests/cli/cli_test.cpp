@@ -701,7 +701,7 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_EQ(chosen["local_ba_keyframes"].get<int>(), 0);
 }
 
-// --segment-every (issue #18's lever): only every n-th frame goes to the network; the frames
+// --segment-every: only every n-th frame goes to the network; the frames
 // between use the newest mask moved by the homographies, so a deterministic run's mask ages are
 // 0, 1, 0, 1, ... and the network runs on half the frames.
 TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
@@ -739,7 +739,7 @@ TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
             "'pspslam run --help')\n");
 }
 
-// Monocular loop closing (issue #16): a colour-only run around a synthetic loop (1.25 turns in
+// Monocular loop closing: a colour-only run around a synthetic loop (1.25 turns in
 // 480 frames, static room) closes the loop with a similarity, says by how much it resized the
 // map, the trajectory gains from it and a second run is identical. The corrected map, saved,
 // serves a localisation run, whose summary reports the loaded map instead of a two-view start.
@@ -848,7 +848,7 @@ TEST(CliRun, MonocularFramesBeforeTheMapStartArePlacedInIt) {
   EXPECT_LT(placed_max, 0.008) << "the frames tracked after: " << rest_rms;
 }
 
-// --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own
+// --video: a synthetic sequence's colour images encoded as MJPG (OpenCV's own
 // encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
 // 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
 TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {

@@ -69,8 +69,8 @@ struct DynamicOptions {
   std::filesystem::path smaller_model;
   int pace_max_stride = 3;
   double frame_period_ms = 1000.0 / 30.0;  // the camera's (the runner sets it from the config)
-  // Homography by default: with flow, the grown masks of a crowd left too few static keypoints
-  // and live runs under injected delays lost frames that the homography policy kept.
+  // Homography by default: masks grown for their age can leave a crowd too few static
+  // keypoints to track.
   StaleMaskPolicy stale_masks = StaleMaskPolicy::homography;
   MaskPropagationParams propagation;
   // A mask more than this many frames old is stale: the geometry stage then tests every

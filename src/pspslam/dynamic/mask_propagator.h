@@ -15,7 +15,7 @@ struct MaskPropagationParams {
   // How fast the parts of a person may move beyond what the flow measured (limbs, turns, a
   // change of pace), m/s: the mask grows by this speed times its age, seen at the person's depth.
   double residual_speed_mps = 0.5;
-  // A crowd's masks grown much further left too few static keypoints: tracking was lost.
+  // Growing a crowd's masks much further leaves too few static keypoints to track.
   int max_growth_px = 12;
   // Around the grown mask, keypoints this many pixels further out are all given the multi-view
   // test while the mask is stale (DynamicOptions::stale_mask_frames).

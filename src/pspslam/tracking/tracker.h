@@ -41,17 +41,14 @@ struct TrackerOptions {
   PoseOptimizerOptions pose_optimizer;
   // A frame tracked with the motion model is optimised with the constant-velocity prediction as a
   // Gaussian prior of these σs (rad, m; 0 = no prior; `pspslam run --motion-prior MM DEG`). Off:
-  // on the accuracy panel (docs/benchmarks.md, #15 item 4) 3 mm / 0.15° lowered the online
-  // trajectory's frame-to-frame jitter in 13 of 13 cells (median −0.8 mm) but not its ATE (7 wins,
-  // 8 losses), and 1 mm / 0.05° raised the ATE by 2–4 mm: the prior trades jitter for wander.
+  // on the accuracy panel it lowered the online trajectory's frame-to-frame jitter but not its
+  // ATE, and tighter σs raised the ATE: the prior trades jitter for wander (docs/benchmarks.md).
   double motion_prior_sigma_rotation = 0.0;
   double motion_prior_sigma_translation = 0.0;
   // Rolling-shutter cameras: how far (rad/s) a frame's rotation rate may be from the previous
   // frame's before the image must show it (the prior of optimize/rolling_shutter_pose.h): 0.03
-  // rad/s in 33 ms is a hand-held angular acceleration of ~50 deg/s^2. 0.1 let the weakly seen
-  // tilt rate follow noise (Bonn: 12 deg/s rms measured where the poses turn at 4) and lost the
-  // dev-clip panel's final trajectory in 6 of 9 cells; 0.03 won 9 of 9 online, 6 of 9 final
-  // (docs/benchmarks.md, "Rolling shutter").
+  // rad/s in 33 ms is a hand-held angular acceleration of ~50 deg/s^2. A looser prior lets the
+  // weakly seen tilt rate follow noise (docs/benchmarks.md, "Rolling shutter").
   double rotation_rate_sigma = 0.03;
   RelocalizerOptions relocalizer;
   // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).

@@ -156,7 +156,7 @@ struct RunFlags {
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   int segment_every = 1;
-  std::string semantic_pace = "on";
+  std::string semantic_pace = "off";
   std::string smaller_model;  // empty: the shipped smaller input when --model is the shipped one
   std::string stale_masks = "homography";
   int stale_mask_growth = MaskPropagationParams{}.max_growth_px;

@@ -603,7 +603,7 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   ASSERT_EQ(synth.status, 0) << synth.output;
   const std::string run = "run --sequence " + (dir / "seq").string() +
                           " --dynamic full --loop-closing off --semantic-delay-ms 100 --out ";
-  const Result live = pspslam(run + (dir / "live").string() + " --realtime");
+  const Result live = pspslam(run + (dir / "live").string() + " --realtime --semantic-pace on");
   ASSERT_EQ(live.status, 0) << live.output;
   EXPECT_TRUE(contains(live.output, "live masks:   ")) << live.output;
   EXPECT_TRUE(contains(live.output, "semantic pace: frames at each level: 0 pspnet.yaml ("))

@@ -65,7 +65,8 @@ struct DynamicOptions {
   // Live runs only (realtime); a deterministic run never changes its network, stride or masks.
   // The semantic thread keeps pace (SemanticPace): it steps down to `smaller_model` (when
   // given), then to every 2nd .. pace_max_stride-th frame, and back up when there is room.
-  bool keep_pace = true;
+  // Off by default: not yet shown to keep more frames posed than one network on every frame.
+  bool keep_pace = false;
   std::filesystem::path smaller_model;
   int pace_max_stride = 3;
   double frame_period_ms = 1000.0 / 30.0;  // the camera's (the runner sets it from the config)

@@ -19,6 +19,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -41,6 +42,7 @@
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
+#include "pspslam/semantic/semantic_delay.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/sequence_runner.h"
 #include "pspslam/viewer/live_viewer.h"
@@ -52,15 +54,13 @@ namespace {
 constexpr int kInterruptedExit = 130;
 // The whole sequence ran and no frame ever started a map: nothing was tracked.
 constexpr int kNeverStartedExit = 3;
-// Nice increment of the background threads in live runs (--background-nice; issue #18 item 1:
-// measured in docs/benchmarks.md "Real time on two cores").
+// Nice increment of the background threads in live runs (--background-nice): the caller thread
+// must track each frame before the next one arrives, so the background work yields the core
+// (docs/decisions/realtime-nice.md).
 constexpr int kLiveBackgroundNice = 10;
 // Local BA window of live runs (--local-ba-keyframes): the best 10 covisible keyframes. On two
-// cores the whole covisible set (35 keyframes, 13k observations, ~0.2 s in a small room) leaves
-// local BA cut short; with 10 it costs a third less and real-time runs on bonn_crowd_dev beat the
-// whole window online in 8 of 8 pairs. Offline runs keep ORB-SLAM2's whole window: on the
-// accuracy panel the capped one lost the final trajectory (docs/benchmarks.md, "The local BA
-// window").
+// cores the whole covisible set of a small room leaves local BA cut short, and the capped window
+// keeps up. Offline runs keep ORB-SLAM2's whole window, which gives the better final trajectory.
 constexpr int kLiveLocalBaKeyframes = 10;
 
 // Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
@@ -154,6 +154,14 @@ struct RunFlags {
   int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   int segment_every = 1;
+  std::string semantic_pace = "off";
+  std::string smaller_model;  // empty: the shipped smaller input when --model is the shipped one
+  std::string stale_masks = "homography";
+  int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
+  std::string mover_guard = "off";
+  std::string stale_geometry = "on";
+  std::string semantic_delay;  // empty: none (fault injection)
+  std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
   int local_ba_keyframes = -1;       // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
@@ -232,6 +240,22 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   dynamic.realtime = flags.realtime;
   dynamic.semantic.mask_dilation_px = flags.mask_margin;
   dynamic.segment_every = flags.segment_every;
+  dynamic.keep_pace = flags.semantic_pace == "on";
+  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
+  if (!flags.smaller_model.empty())
+    dynamic.smaller_model = flags.smaller_model;
+  else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
+    dynamic.smaller_model = shipped_smaller;
+  system.tracker.mover_guard.enabled = flags.mover_guard == "on";
+  dynamic.tighten_geometry = flags.stale_geometry == "on";
+  dynamic.propagation.max_growth_px = flags.stale_mask_growth;
+  dynamic.stale_masks =
+      flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
+  if (!flags.semantic_delay.empty()) {
+    dynamic.semantic.injected_delay =
+        parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
+    dynamic.semantic.injected_delay.seed = flags.semantic_delay_seed;
+  }
   dynamic.culling.min_dynamic_hits = flags.cull_hits;
   system.place.relocalization = !flags.no_relocalization;
   if (!flags.load_map.empty()) {
@@ -389,6 +413,60 @@ Command add_run_command(CLI::App& root) {
                   "with the camera by the frame-to-frame homographies")
       ->check(in_range(1, 30))
       ->capture_default_str();
+  app->add_option("--semantic-pace", flags->semantic_pace,
+                  "with --realtime: when segmentation falls behind the camera, step down by "
+                  "itself to the smaller network input (--smaller-model), then to segmenting "
+                  "every 2nd or 3rd frame, and back up when there is room (off: one network on "
+                  "every frame it can take)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--smaller-model", flags->smaller_model,
+                  "the smaller segmentation model --semantic-pace steps down to (default: the "
+                  "shipped models/pspnet/pspnet_288x192.yaml when --model is the shipped one, "
+                  "else none: only sparser frames)")
+      ->check(CLI::ExistingFile);
+  app->add_option("--stale-masks", flags->stale_masks,
+                  "with --realtime, how an older mask is brought into the frame: flow = each "
+                  "person moves by the optical flow inside it and the mask grows with its age, "
+                  "and keypoints near a mask more than 2 frames old get the geometry test "
+                  "(experimental: it can leave a crowd too few static keypoints); homography = "
+                  "moved with the camera only")
+      ->check(CLI::IsMember({"flow", "homography"}))
+      ->capture_default_str();
+  app->add_option("--stale-mask-growth", flags->stale_mask_growth,
+                  "with --stale-masks flow: the most pixels a moved mask grows by for its age")
+      ->check(in_range(0, 200))
+      ->capture_default_str();
+  app->add_option("--stale-geometry", flags->stale_geometry,
+                  "with --realtime and --stale-masks flow: while the mask is more than 2 frames "
+                  "old, every keypoint in a band around it gets the multi-view geometry test")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--mover-guard", flags->mover_guard,
+                  "experimental: when a frame's inliers drop and its pose jumps off the "
+                  "constant-velocity prediction (tracking following a crowd), hold the "
+                  "prediction for up to 3 frames")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  CLI::Option* semantic_delay =
+      app->add_option("--semantic-delay-ms", flags->semantic_delay,
+                      "fault injection: MS or random:MIN:MAX milliseconds of extra wait after each "
+                      "segmentation, as if the network were that much slower (reproduces a "
+                      "network that falls behind the camera)")
+          ->check(CLI::Validator(
+              [](std::string& value) {
+                try {
+                  parse_semantic_delay(value, "--semantic-delay-ms");
+                  return std::string();
+                } catch (const Error& e) {
+                  return std::string(e.what());
+                }
+              },
+              "MS|random:MIN:MAX"));
+  app->add_option("--semantic-delay-seed", flags->semantic_delay_seed,
+                  "seed of the random:MIN:MAX delays (the same seed draws the same delays)")
+      ->needs(semantic_delay)
+      ->capture_default_str();
   app->add_option("--semantic-masks", flags->semantic_masks,
                   "read each frame's semantic mask from this folder instead of running the "
                   "network: DIR/<colour image name>.png, 8-bit, non-zero = dynamic (what "
@@ -414,12 +492,11 @@ Command add_run_command(CLI::App& root) {
   app->add_flag("--due-keyframes", flags->due_keyframes,
                 "also make a keyframe once a second has passed since the last one, whatever "
                 "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "
-                "off by default: mixed on the accuracy panel, docs/benchmarks.md #15 item 5)");
+                "off by default: docs/decisions/due-keyframes.md)");
   app->add_option("--motion-prior", flags->motion_prior,
                   "MM DEG: optimise each frame tracked with the motion model with its "
                   "constant-velocity prediction as a prior of these σs (translation mm, rotation "
-                  "degrees; default: no prior; an experiment: less jitter, not a lower ATE, "
-                  "docs/benchmarks.md)")
+                  "degrees; default: no prior; it lowers the jitter, not the ATE)")
       ->expected(2)
       ->check(in_range(1e-3, 1e3));
   app->add_option("--vocabulary", flags->vocabulary,

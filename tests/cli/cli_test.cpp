@@ -537,6 +537,17 @@ TEST(CliRun, FlagValuesAreCheckedBeforeAnyWork) {
   EXPECT_EQ(r.output,
             "error: pspslam run: --blackout: --blackout expects FROM:COUNT (frame index and a "
             "positive number of frames), got '3' (see 'pspslam run --help')\n");
+  r = pspslam(run + "--semantic-delay-ms random:300:100");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --semantic-delay-ms: --semantic-delay-ms expects MS or "
+            "random:MIN:MAX (whole milliseconds, 0-10000, MIN <= MAX), got 'random:300:100' "
+            "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--semantic-delay-seed 4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --semantic-delay-seed requires --semantic-delay-ms (see 'pspslam "
+            "run --help')\n");
   r = pspslam(run + "--max-frames -1");
   EXPECT_EQ(r.output,
             "error: pspslam run: --max-frames: must be an integer in [0, 1000000000], got '-1' "
@@ -580,8 +591,49 @@ TEST(CliRun, StatsJsonEscapesTheSequencePath) {
   EXPECT_EQ(stats["frames"], 3);
 }
 
+// stats.json `live_masks`: a live run says how many frames ran on a stale mask and, per level of
+// the semantic pace (the shipped network, the smaller one, then every 2nd and 3rd frame), how
+// many frames ran while the thread was there; the frames add up to the frames with a level. A
+// deterministic run has no such member and never steps down. An injected delay makes stale
+// masks likely, but how many depends on the machine: only the bookkeeping is checked.
+TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
+  const auto dir = testing::make_temp_dir("cli_live_masks");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 40 --bodies 2 --seed 4");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const std::string run = "run --sequence " + (dir / "seq").string() +
+                          " --dynamic full --loop-closing off --semantic-delay-ms 100 --out ";
+  const Result live = pspslam(run + (dir / "live").string() + " --realtime --semantic-pace on");
+  ASSERT_EQ(live.status, 0) << live.output;
+  EXPECT_TRUE(contains(live.output, "live masks:   ")) << live.output;
+  EXPECT_TRUE(contains(live.output, "semantic pace: frames at each level: 0 pspnet.yaml ("))
+      << live.output;
+  std::ifstream in(dir / "live" / "stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  const nlohmann::json& masks = stats["live_masks"];
+  EXPECT_EQ(masks["stale_after_frames"].get<int>(), 2);
+  EXPECT_EQ(masks["stale_masks"].get<std::string>(), "homography");
+  EXPECT_LE(masks["frames_on_stale_mask"].get<int>(), stats["frames"].get<int>());
+  const nlohmann::json& levels = masks["pace"]["levels"];
+  ASSERT_EQ(levels.size(), 4u);
+  EXPECT_EQ(levels[1]["network"].get<std::string>(), "pspnet_288x192.yaml (288x192)");
+  EXPECT_EQ(levels[3]["stride"].get<int>(), 3);
+  int frames = 0;
+  for (const nlohmann::json& level : levels) frames += level["frames"].get<int>();
+  EXPECT_GT(frames, 0);
+  EXPECT_LE(frames, stats["frames"].get<int>());
+  EXPECT_EQ(masks["pace"]["frames_stepped_down"].get<int>(),
+            stats["frames"].get<int>() - levels[0]["frames"].get<int>());
+
+  const Result deterministic = pspslam(run + (dir / "deterministic").string());
+  ASSERT_EQ(deterministic.status, 0) << deterministic.output;
+  EXPECT_FALSE(contains(deterministic.output, "live masks:")) << deterministic.output;
+  std::ifstream in_deterministic(dir / "deterministic" / "stats.json");
+  EXPECT_FALSE(nlohmann::json::parse(in_deterministic).contains("live_masks"));
+}
+
 // stats.json `latency`: with --realtime every processed frame has its arrival-to-pose time
-// (issue #18's real-time figures); a deterministic run has no arrival times and reports none.
+// (the real-time figures); a deterministic run has no arrival times and reports none.
 // `scheduling`: a real-time run lowers the background threads (nice 10), gives OpenCV one thread
 // and local BA the best 10 covisible keyframes; a deterministic run changes none of them (the
 // whole covisible window: 0); --background-nice / --opencv-threads / --local-ba-keyframes
@@ -649,7 +701,7 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_EQ(chosen["local_ba_keyframes"].get<int>(), 0);
 }
 
-// --segment-every (issue #18's lever): only every n-th frame goes to the network; the frames
+// --segment-every: only every n-th frame goes to the network; the frames
 // between use the newest mask moved by the homographies, so a deterministic run's mask ages are
 // 0, 1, 0, 1, ... and the network runs on half the frames.
 TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
@@ -687,7 +739,7 @@ TEST(CliRun, SegmentEveryOtherFrameWarpsTheNewestMaskToTheRest) {
             "'pspslam run --help')\n");
 }
 
-// Monocular loop closing (issue #16): a colour-only run around a synthetic loop (1.25 turns in
+// Monocular loop closing: a colour-only run around a synthetic loop (1.25 turns in
 // 480 frames, static room) closes the loop with a similarity, says by how much it resized the
 // map, the trajectory gains from it and a second run is identical. The corrected map, saved,
 // serves a localisation run, whose summary reports the loaded map instead of a two-view start.
@@ -796,7 +848,7 @@ TEST(CliRun, MonocularFramesBeforeTheMapStartArePlacedInIt) {
   EXPECT_LT(placed_max, 0.008) << "the frames tracked after: " << rest_rms;
 }
 
-// --video (issue #16): a synthetic sequence's colour images encoded as MJPG (OpenCV's own
+// --video: a synthetic sequence's colour images encoded as MJPG (OpenCV's own
 // encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
 // 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
 TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {

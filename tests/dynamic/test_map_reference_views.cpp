@@ -31,7 +31,7 @@ std::shared_ptr<KeyFrame> keyframe_with(std::uint64_t id, const Pose& T_world_ca
       std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{})));
 }
 
-// Issue #20: a keyframe of a loaded map becomes a reference depth image from its keypoints'
+// A keyframe of a loaded map becomes a reference depth image from its keypoints'
 // depths: squares of the splat radius, the nearer surface where two overlap, 0 elsewhere.
 TEST(MapReferenceViews, KeypointDepthsAreSplattedNearestFirst) {
   PinholeCamera camera;  // 640x480, no distortion

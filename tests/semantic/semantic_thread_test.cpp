@@ -278,6 +278,63 @@ TEST(SemanticThread, SegmentsAtTheRequestedLowerPriority) {
   EXPECT_EQ(nice.load(), std::min(19, this_thread_nice() + 4));
 }
 
+TEST(SemanticThread, AnInjectedDelayCountsAsInference) {
+  auto control = std::make_shared<FakeSegmenter::Control>();
+  SemanticParams params;
+  params.injected_delay = {60, 60};
+  SemanticThread thread(std::make_unique<FakeSegmenter>(control, 0ms), params);
+  thread.submit(1, 1.0, frame_image(1));
+  const auto result = thread.wait_for(1, 5s);
+  ASSERT_NE(result, nullptr);
+  EXPECT_GE(result->inference_ms, 60.0);  // a sleep lasts at least as long as asked
+  EXPECT_EQ(cv::countNonZero(result->labels != 1), 0);
+}
+
+// Labels every pixel with `label`, so a result says which of a thread's segmenters made it.
+class ConstantSegmenter : public FakeSegmenter {
+ public:
+  ConstantSegmenter(std::shared_ptr<Control> control, int label)
+      : FakeSegmenter(std::move(control), 0ms), label_(label) {}
+  LabelMap segment(const cv::Mat& bgr) override {
+    FakeSegmenter::segment(bgr);
+    return LabelMap(bgr.size(), CV_8UC1, cv::Scalar(label_));
+  }
+
+ private:
+  int label_;
+};
+
+TEST(SemanticThread, APaceTooSlowForTheBudgetStepsDownToTheSmallerNetworkAndSparserFrames) {
+  auto control = std::make_shared<FakeSegmenter::Control>();
+  SemanticParams params;
+  params.injected_delay = {40, 40};  // far over the 2 x 1 ms budget
+  params.dynamic_classes = {"person", "c12"};
+  SemanticPaceParams pace;
+  pace.frame_period_ms = 1.0;
+  pace.results_to_step_down = 1;
+  std::vector<std::unique_ptr<Segmenter>> segmenters;
+  segmenters.push_back(std::make_unique<ConstantSegmenter>(control, 15));
+  segmenters.push_back(std::make_unique<ConstantSegmenter>(control, 12));
+  SemanticThread thread(std::move(segmenters), params,
+                        SemanticPace(pace, pace_ladder(2, 2), {2.0, 1.0}));
+  EXPECT_EQ(thread.stride(), 1);
+  for (std::int64_t id = 1; id <= 3; ++id) {
+    thread.submit(id, static_cast<double>(id), frame_image(id));
+    const auto result = thread.wait_for(id, 5s);
+    ASSERT_NE(result, nullptr);
+    EXPECT_EQ(result->level, id - 1);
+    // Level 0 runs the first segmenter (person = 15), levels 1 and 2 the second (dog = 12).
+    EXPECT_EQ(result->labels.at<uchar>(0, 0), id == 1 ? 15 : 12);
+    EXPECT_EQ(cv::countNonZero(result->dynamic_mask), result->labels.rows * result->labels.cols);
+  }
+  thread.wait_idle();
+  EXPECT_EQ(thread.stride(), 2);
+  const SemanticStats stats = thread.stats();
+  EXPECT_EQ(stats.level, 2);
+  EXPECT_EQ(stats.level_changes, 2);
+  EXPECT_EQ(stats.processed_per_level, (std::vector<std::int64_t>{1, 1, 1}));
+}
+
 TEST(DynamicMask, MarksDynamicLabelsAndGrowsByTheMargin) {
   LabelMap labels(40, 50, CV_8UC1, cv::Scalar(0));
   labels(cv::Rect(10, 10, 5, 5)).setTo(15);  // person

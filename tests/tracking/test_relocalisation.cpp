@@ -76,7 +76,7 @@ SyntheticScene exact_depth_room() {
   return SyntheticScene(options);
 }
 
-// Issue #4 "done when": 30 black frames, then the system relocalises within 5 frames of the
+// 30 black frames, then the system relocalises within 5 frames of the
 // return and the poses after it are within 2 cm of ground truth. Then a second blackout after
 // which the camera is back where it was 1.5 s earlier (kidnapped), to be found through the
 // keyframe database among all keyframes.

@@ -17,6 +17,34 @@
 #include "pspslam/semantic/semantic_thread.h"
 
 namespace pspslam {
+namespace {
+
+// The semantic thread of `options`: a live run that keeps pace gets the smaller network too and
+// a SemanticPace over both; every other run one network on every frame it is given.
+std::unique_ptr<SemanticThread> make_semantic_thread(const DynamicOptions& options,
+                                                     const SemanticParams& params) {
+  std::vector<std::unique_ptr<Segmenter>> segmenters;
+  std::vector<double> costs;
+  const auto add = [&](const std::filesystem::path& model) {
+    auto segmenter = OnnxSegmenter::from_file(model);
+    costs.push_back(static_cast<double>(segmenter->metadata().input_width) *
+                    segmenter->metadata().input_height);
+    segmenters.push_back(std::move(segmenter));
+  };
+  add(options.model);
+  if (!options.realtime || !options.keep_pace)
+    return std::make_unique<SemanticThread>(std::move(segmenters.front()), params);
+  if (!options.smaller_model.empty()) add(options.smaller_model);
+  SemanticPaceParams pace;
+  pace.frame_period_ms = options.frame_period_ms;
+  const int networks = static_cast<int>(segmenters.size());
+  return std::make_unique<SemanticThread>(
+      std::move(segmenters), params,
+      SemanticPace(pace, pace_ladder(networks, std::max(1, options.pace_max_stride)), costs));
+}
+
+}  // namespace
+
 const char* to_string(KeypointFate fate) {
   switch (fate) {
     case KeypointFate::tracked:
@@ -44,7 +72,9 @@ DynamicPipeline::DynamicPipeline(const DynamicOptions& options, const PinholeCam
     // Deterministic mode announces one frame ahead: two may be pending and none may be
     // dropped. Real-time mode keeps only the newest pending frame.
     params.queue_size = options.realtime ? 1 : 2;
-    semantic_ = std::make_unique<SemanticThread>(OnnxSegmenter::from_file(options.model), params);
+    semantic_ = make_semantic_thread(options, params);
+    if (options.realtime && options.stale_masks == StaleMaskPolicy::flow)
+      propagator_.emplace(camera.fx, options.frame_period_ms * 1e-3, options.propagation);
   }
 }
 
@@ -54,8 +84,15 @@ DynamicPipeline::~DynamicPipeline() = default;
 void DynamicPipeline::announce(const RgbdFrame& frame) {
   if (!semantic_) return;
   const std::int64_t id = next_announced_++;
-  // With a stride the frames in between use the newest mask, warped (semantic_mask()).
-  if (id % options_.segment_every != 0) return;
+  // With a stride the frames in between use the newest mask, warped (semantic_mask()). A live
+  // run's stride may change under the pace: it counts from the last frame segmented.
+  if (options_.realtime) {
+    const int stride = std::max(options_.segment_every, semantic_->stride());
+    if (last_segmented_ >= 0 && id - last_segmented_ < stride) return;
+  } else if (id % options_.segment_every != 0) {
+    return;
+  }
+  last_segmented_ = id;
   submitted_.push_back({id, frame.timestamp, std::chrono::steady_clock::now()});
   while (submitted_.size() > 64) submitted_.pop_front();
   semantic_->submit(id, frame.timestamp, frame.bgr);
@@ -65,6 +102,8 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
                                      DynamicReport& report) {
   current_id_ = next_id_++;
   labels_.release();
+  watch_mask_.release();
+  cull_mask_.release();
   if (semantic_ && next_announced_ <= current_id_) announce(frame);
   const auto start = std::chrono::steady_clock::now();
   H_previous_to_current_.reset();
@@ -77,6 +116,7 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
     if (H.valid) H_previous_to_current_ = H.H;
   }
   chain_.record(current_id_, H_previous_to_current_);
+  if (propagator_) propagator_->add_frame(current_id_, gray, frame.depth);
   previous_gray_ = gray;
   report.flow_ms = milliseconds_since(start);
   if (semantic_) return semantic_mask(report);
@@ -128,7 +168,11 @@ void DynamicPipeline::remove_dynamic(const cv::Mat& depth, std::span<const float
     input.references = views_;
     // The stage maps each keypoint back through the flow step's H into the previous mask, so
     // the mask needs no full-image warp here.
-    if (!previous_mask_.empty() && H_previous_to_current_) {
+    if (!watch_mask_.empty()) {
+      // A stale mask: the prior is already in this frame (no homography to map back through).
+      input.previous_dynamic_mask = watch_mask_;
+      report.geometry_tightened = true;
+    } else if (!previous_mask_.empty() && H_previous_to_current_) {
       input.previous_dynamic_mask = previous_mask_;
       input.H_previous_to_current = H_previous_to_current_;
     }
@@ -205,9 +249,11 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     last_pose_ = result.T_world_camera;
     last_pose_id_ = current_id_;
     if (!previous_mask_.empty() && !protect_map_) {
+      const cv::Mat cull_mask =
+          cull_mask_.empty() ? previous_mask_ : fuse_dynamic_masks(cull_mask_, geometry_mask_, 0);
       const auto points = map_.reference_map_points();
       const auto& culled =
-          culler_.observe(points, *result.T_world_camera, previous_mask_, depth, camera_);
+          culler_.observe(points, *result.T_world_camera, cull_mask, depth, camera_);
       if (!culled.empty()) {
         std::lock_guard lock(map_.update_mutex());
         for (const auto& point : culled) map_.erase_map_point(point);
@@ -227,19 +273,42 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
     report.semantic_wait_ms = milliseconds_since(start);
   }
   if (!result) result = semantic_->newest();
+  if (options_.realtime && options_.keep_pace) report.semantic_pace_level = semantic_->level();
   if (!result || result->frame_id > current_id_) return {};
-  const WarpedMask warped =
-      warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
-  if (warped.mask.empty()) return {};
-  report.mask_age_frames = warped.age_frames;
-  report.mask_warped = warped.warped;
+  cv::Mat mask;
+  if (propagator_) {
+    mask = propagate_mask(*result, report);
+  } else {
+    const WarpedMask warped =
+        warp_mask_to_frame(result->dynamic_mask, result->frame_id, current_id_, chain_);
+    report.mask_age_frames = warped.age_frames;
+    report.mask_warped = warped.warped;
+    mask = warped.mask;
+  }
+  if (mask.empty()) return {};
   report.semantic_inference_ms = result->inference_ms;
+  if (options_.realtime && options_.keep_pace) report.semantic_level = result->level;
   labels_ = result->labels;
   for (const Submitted& submitted : submitted_) {
     if (submitted.id == result->frame_id)
       report.mask_latency_ms = milliseconds_since(submitted.time);
   }
-  return warped.mask;
+  return mask;
+}
+
+cv::Mat DynamicPipeline::propagate_mask(const SemanticResult& result, DynamicReport& report) {
+  const bool stale = current_id_ - result.frame_id > options_.stale_mask_frames;
+  PropagatedMask moved = propagator_->propagate(result.dynamic_mask, result.frame_id, current_id_,
+                                                chain_, stale && options_.tighten_geometry);
+  report.mask_age_frames = moved.age_frames;
+  report.mask_warped = moved.age_frames > 0;
+  report.mask_moved_by_flow = moved.moved_by_flow > 0;
+  report.mask_growth_px = moved.growth_px;
+  if (stale && options_.tighten_geometry) watch_mask_ = std::move(moved.watch);
+  // Map points are culled on the people's moved outline: the growth is a margin of doubt, and
+  // static points inside it must not be erased for it.
+  cull_mask_ = std::move(moved.moved);
+  return moved.mask;
 }
 
 // The geometry stage's reference pool: the depth images of this run's newest keyframes, or in

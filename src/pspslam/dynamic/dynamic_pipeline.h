@@ -16,6 +16,7 @@
 #include "pspslam/dynamic/dynamic_point_culler.h"
 #include "pspslam/dynamic/frame_flow.h"
 #include "pspslam/dynamic/map_reference_views.h"
+#include "pspslam/dynamic/mask_propagator.h"
 #include "pspslam/dynamic/mask_warper.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/geometry/geometry_stage.h"
@@ -27,9 +28,16 @@ namespace pspslam {
 class KeyFrame;
 class Map;
 class SemanticThread;
+struct SemanticResult;
 struct RgbdFrame;
 
-// How dynamic content is detected and removed (issue #7; `pspslam run --dynamic`).
+// How a live run brings an older mask into the current frame.
+enum class StaleMaskPolicy : std::uint8_t {
+  homography,  // with the camera's frame-to-frame homographies only
+  flow,        // with the people's own flow, grown with the mask's age (MaskPropagator)
+};
+
+// How dynamic content is detected and removed (`pspslam run --dynamic`).
 struct DynamicOptions {
   DynamicMode mode = DynamicMode::off;
   // Segmenter metadata YAML (semantic, full, exhaustive); must exist for those modes.
@@ -53,6 +61,26 @@ struct DynamicOptions {
   int segment_every = 1;
   // Deterministic mode gives up on a frame's mask after this long (then runs without it).
   std::chrono::milliseconds semantic_timeout{30000};
+
+  // Live runs only (realtime); a deterministic run never changes its network, stride or masks.
+  // The semantic thread keeps pace (SemanticPace): it steps down to `smaller_model` (when
+  // given), then to every 2nd .. pace_max_stride-th frame, and back up when there is room.
+  // Off by default: not yet shown to keep more frames posed than one network on every frame.
+  bool keep_pace = false;
+  std::filesystem::path smaller_model;
+  int pace_max_stride = 3;
+  double frame_period_ms = 1000.0 / 30.0;  // the camera's (the runner sets it from the config)
+  // Homography by default: masks grown for their age can leave a crowd too few static
+  // keypoints to track.
+  StaleMaskPolicy stale_masks = StaleMaskPolicy::homography;
+  MaskPropagationParams propagation;
+  // A mask more than this many frames old is stale: the geometry stage then tests every
+  // keypoint near it (MaskPropagationParams::watch_band_px), and the summary counts the frame.
+  int stale_mask_frames = 2;
+  // While the mask is stale, the geometry stage's prior is the band around the moved mask
+  // instead of the previous frame's fused mask. Not the fused mask as well: it holds last
+  // frame's grown mask and regions, and a prior that includes its own growth widens each frame.
+  bool tighten_geometry = true;
 };
 
 // What became of one extracted keypoint (pictures of a run: `pspslam run --save-overlays`).
@@ -96,6 +124,13 @@ struct DynamicReport {
   int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
   int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
   int culled_map_points = 0;  // map points erased for lying on dynamic pixels
+  // Live runs with a pace: the level the mask used was made at, and the thread's level now
+  // (-1: no pace or no mask).
+  int semantic_level = -1;
+  int semantic_pace_level = -1;
+  bool mask_moved_by_flow = false;  // at least one part of the mask moved by its own flow
+  int mask_growth_px = 0;           // growth of the moved mask for its age
+  bool geometry_tightened = false;  // every keypoint near a stale mask got the multi-view test
 };
 
 // The dynamic-scene stages around tracking (paper Fig. 1) and their state between frames:
@@ -128,7 +163,7 @@ class DynamicPipeline {
                       const cv::Mat& semantic_mask, OrbFeatures& features, DynamicReport& report,
                       std::vector<KeypointRecord>* dropped = nullptr);
 
-  // Localisation (issue #20): the loaded map must stay as it was saved, so no map point is
+  // Localisation: the loaded map must stay as it was saved, so no map point is
   // culled, and the geometry stage takes its reference views from the map's keyframes since
   // the run inserts none. Call after the map is loaded.
   void use_loaded_map_only();
@@ -164,6 +199,8 @@ class DynamicPipeline {
 
   cv::Mat mask_from_file(const RgbdFrame& frame, DynamicReport& report) const;
   cv::Mat semantic_mask(DynamicReport& report);
+  // A live run's older mask moved into the current frame (StaleMaskPolicy::flow).
+  cv::Mat propagate_mask(const SemanticResult& result, DynamicReport& report);
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;
 
@@ -175,13 +212,15 @@ class DynamicPipeline {
   PinholeCamera camera_;
   Map& map_;
   std::unique_ptr<SemanticThread> semantic_;
+  std::optional<MaskPropagator> propagator_;  // live runs with StaleMaskPolicy::flow
   std::unique_ptr<GeometryStage> geometry_;
   FrameFlow flow_;
   HomographyChain chain_;
   DynamicPointCuller culler_;
 
-  std::int64_t next_id_ = 0;         // processed frames
-  std::int64_t next_announced_ = 0;  // frames handed to the semantic thread
+  std::int64_t next_id_ = 0;          // processed frames
+  std::int64_t next_announced_ = 0;   // frames handed to the semantic thread
+  std::int64_t last_segmented_ = -1;  // the last frame handed to it to segment
   std::int64_t current_id_ = 0;
   std::deque<Submitted> submitted_;
   std::deque<Reference> references_;                 // newest keyframe first
@@ -191,7 +230,9 @@ class DynamicPipeline {
   cv::Mat previous_gray_;
   cv::Mat previous_mask_;  // fused semantic + geometry mask of the previous frame
   cv::Mat geometry_mask_;
-  cv::Mat labels_;  // of the mask used for the current frame
+  cv::Mat watch_mask_;  // around a stale mask, for the geometry stage; empty otherwise
+  cv::Mat cull_mask_;   // a moved mask before its growth; empty: cull on the fused mask
+  cv::Mat labels_;      // of the mask used for the current frame
   GeometryPicture picture_;
   std::optional<Pose> last_pose_;
   std::optional<Pose> velocity_;

@@ -24,7 +24,7 @@ struct DynamicCullingParams {
 };
 
 // Counts, per map point, the frames in which it lay on dynamic pixels and reports the points that
-// reached the threshold (issue #7: points created on a person before she was detected -- e.g. she
+// reached the threshold (points created on a person before she was detected -- e.g. she
 // stood still in the first frames -- must leave the map once she is known to be dynamic).
 // Not thread-safe: used by the tracking thread only. Buffers are reused.
 class DynamicPointCuller {

@@ -7,7 +7,7 @@
 
 namespace pspslam {
 
-// Fusion of the two dynamic verdicts for one frame (issue #7): a keypoint is dynamic when it lies
+// Fusion of the two dynamic verdicts for one frame: a keypoint is dynamic when it lies
 // on the (dilated) semantic mask of an a-priori dynamic class, or when the geometry stage flagged
 // it (tested dynamic, or inside a region grown from dynamic points -- which is how objects of
 // static classes that move, e.g. a carried box, become dynamic).

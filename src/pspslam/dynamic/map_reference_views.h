@@ -13,7 +13,7 @@ namespace pspslam {
 class KeyFrame;
 class Map;
 
-// Reference views for the geometry stage in localisation mode (issue #20). A live run feeds the
+// Reference views for the geometry stage in localisation mode. A live run feeds the
 // multi-view test the depth images of the keyframes it inserts; localisation inserts none, and a
 // map file keeps no depth images. What it keeps per keyframe is the measured depth of every
 // keypoint, so a reference depth image is rebuilt from those: each keypoint's depth is splatted

@@ -9,7 +9,7 @@
 namespace pspslam {
 
 // Frame-to-frame compensated homographies (paper eq. 10-11) of the recent frames, so that a mask
-// computed for an older frame can be brought into the current one (issue #7, real-time policy:
+// computed for an older frame can be brought into the current one (real-time policy:
 // segmentation is slower than tracking, so the newest mask is often a few frames old).
 class HomographyChain {
  public:

@@ -53,8 +53,8 @@ void normalise_into_planes(const cv::Mat& bgr, const int source_channel[3], cons
 // Arg-max over `classes` planes of `plane` logits each (first maximum wins, as numpy.argmax).
 // One pass over the logits: 16 pixels keep their best value and class in registers while the
 // class planes stream by (the class id is carried as a float so that compare and select stay
-// in one lane width). Comparing plane by plane against a best-value buffer took most of the
-// 2.1 ms post-processing at 288x240, now 0.9 ms with the label resize (bench --profile).
+// in one lane width): comparing plane by plane against a best-value buffer in memory costs most
+// of the post-processing.
 void argmax_over_planes(const float* logits, int classes, size_t plane, uchar* labels) {
   size_t i = 0;
   for (; i + 16 <= plane; i += 16) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "pspslam/core/yaml_section.h"
+#include "pspslam/semantic/semantic_delay.h"
 
 namespace pspslam {
 
@@ -19,6 +20,8 @@ struct SemanticParams {
   int history = 64;          // published results kept for look-up by timestamp
   // Nice increment of the semantic thread (not a YAML key: real-time runs set it).
   int thread_nice = 0;
+  // Extra wait after each segmentation (not a YAML key: `run --semantic-delay-ms`).
+  SemanticDelay injected_delay;
 
   // Reads the keys of `section`, calls section.finish() (unknown keys are errors) and
   // validates the values (pspslam::Error naming the key).

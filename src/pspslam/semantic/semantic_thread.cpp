@@ -8,16 +8,46 @@
 #include "pspslam/core/thread_priority.h"
 
 namespace pspslam {
+namespace {
+
+std::vector<std::unique_ptr<Segmenter>> one_segmenter(std::unique_ptr<Segmenter> segmenter) {
+  std::vector<std::unique_ptr<Segmenter>> segmenters;
+  segmenters.push_back(std::move(segmenter));
+  return segmenters;
+}
+
+}  // namespace
+
 SemanticThread::SemanticThread(std::unique_ptr<Segmenter> segmenter, const SemanticParams& params)
-    : segmenter_(std::move(segmenter)),
+    : SemanticThread(one_segmenter(std::move(segmenter)), params, std::nullopt) {}
+
+SemanticThread::SemanticThread(std::vector<std::unique_ptr<Segmenter>> segmenters,
+                               const SemanticParams& params, std::optional<SemanticPace> pace)
+    : segmenters_(std::move(segmenters)),
+      pace_(std::move(pace)),
+      delay_(params.injected_delay),
       dilation_px_(params.mask_dilation_px),
       queue_size_(static_cast<size_t>(std::max(1, params.queue_size))),
       history_size_(static_cast<size_t>(std::max(1, params.history))) {
-  if (!segmenter_) throw Error("SemanticThread: no segmenter given");
-  dynamic_ids_ = params.dynamic_classes.empty()
-                     ? segmenter_->default_dynamic_classes()
-                     : class_ids(segmenter_->class_names(), params.dynamic_classes,
-                                 "semantic.dynamic_classes");
+  if (segmenters_.empty() || !segmenters_.front())
+    throw Error("SemanticThread: no segmenter given");
+  const Segmenter& first = *segmenters_.front();
+  for (const auto& segmenter : segmenters_) {
+    if (!segmenter || segmenter->class_names() != first.class_names())
+      throw Error("SemanticThread: the segmenters of one thread must have the same classes");
+  }
+  if (pace_) {
+    for (const PaceLevel& level : pace_->levels()) {
+      if (static_cast<size_t>(level.network) >= segmenters_.size())
+        throw Error("SemanticThread: a pace level names a segmenter that was not given");
+    }
+    stats_.processed_per_level.assign(pace_->levels().size(), 0);
+    stride_ = pace_->current().stride;
+  }
+  dynamic_ids_ =
+      params.dynamic_classes.empty()
+          ? first.default_dynamic_classes()
+          : class_ids(first.class_names(), params.dynamic_classes, "semantic.dynamic_classes");
   worker_ = std::thread([this, nice = params.thread_nice] {
     lower_this_thread_priority(nice);
     run();
@@ -77,12 +107,8 @@ void SemanticThread::run() {
       busy_ = true;
     }
     auto result = std::make_shared<SemanticResult>();
-    result->frame_id = job.frame_id;
-    result->timestamp = job.timestamp;
-    const auto t0 = Clock::now();
     try {
-      result->labels = segmenter_->segment(job.bgr);
-      result->dynamic_mask = dynamic_mask(result->labels, dynamic_ids_, dilation_px_);
+      segment(job, *result);
     } catch (const std::exception& e) {
       // A failing frame must not end the thread: nothing is published for it (consumers
       // waiting for it are released), and the failure is counted and kept for stats().
@@ -95,18 +121,45 @@ void SemanticThread::run() {
       done_cv_.notify_all();
       continue;
     }
-    result->inference_ms = milliseconds_since(t0);
     result->latency_ms = milliseconds_since(job.submitted);
-    {
-      std::lock_guard lock(mutex_);
-      history_.push_back(std::move(result));
-      while (history_.size() > history_size_) history_.pop_front();
-      ++stats_.processed;
-      last_finished_id_ = std::max(last_finished_id_, job.frame_id);
-      busy_ = false;
-    }
-    done_cv_.notify_all();
+    publish(std::move(result));
   }
+}
+
+void SemanticThread::segment(const Pending& job, SemanticResult& result) {
+  result.frame_id = job.frame_id;
+  result.timestamp = job.timestamp;
+  result.level = pace_ ? pace_->level() : 0;
+  Segmenter& segmenter =
+      *segmenters_[pace_ ? static_cast<size_t>(pace_->current().network) : size_t{0}];
+  const auto t0 = Clock::now();
+  result.labels = segmenter.segment(job.bgr);
+  result.dynamic_mask = dynamic_mask(result.labels, dynamic_ids_, dilation_px_);
+  const std::chrono::milliseconds injected = delay_.next();
+  if (injected.count() > 0) std::this_thread::sleep_for(injected);
+  result.inference_ms = milliseconds_since(t0);
+}
+
+void SemanticThread::publish(std::shared_ptr<SemanticResult> result) {
+  if (pace_) {
+    pace_->observe(result->inference_ms);
+    stride_.store(pace_->current().stride, std::memory_order_relaxed);
+    level_.store(pace_->level(), std::memory_order_relaxed);
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (pace_) {
+      ++stats_.processed_per_level[static_cast<size_t>(result->level)];
+      stats_.level_changes = pace_->changes();
+      stats_.level = pace_->level();
+    }
+    last_finished_id_ = std::max(last_finished_id_, result->frame_id);
+    history_.push_back(std::move(result));
+    while (history_.size() > history_size_) history_.pop_front();
+    ++stats_.processed;
+    busy_ = false;
+  }
+  done_cv_.notify_all();
 }
 
 std::shared_ptr<const SemanticResult> SemanticThread::newest() const {

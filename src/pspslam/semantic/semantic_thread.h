@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -16,6 +17,8 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/semantic/segmenter.h"
+#include "pspslam/semantic/semantic_delay.h"
+#include "pspslam/semantic/semantic_pace.h"
 #include "pspslam/semantic/semantic_params.h"
 
 namespace pspslam {
@@ -24,10 +27,11 @@ namespace pspslam {
 struct SemanticResult {
   std::int64_t frame_id = 0;
   Timestamp timestamp = 0.0;
-  LabelMap labels;        // CV_8UC1 class ids, image size
-  cv::Mat dynamic_mask;   // CV_8UC1, 255 = dynamic class (dilated by mask_dilation_px)
-  double latency_ms = 0;  // from submit() to publication (queueing + inference)
-  double inference_ms = 0;
+  LabelMap labels;          // CV_8UC1 class ids, image size
+  cv::Mat dynamic_mask;     // CV_8UC1, 255 = dynamic class (dilated by mask_dilation_px)
+  double latency_ms = 0;    // from submit() to publication (queueing + inference)
+  double inference_ms = 0;  // includes an injected delay (SemanticParams::injected_delay)
+  int level = 0;            // the SemanticPace level it was made at (0 without a pace)
 };
 
 struct SemanticStats {
@@ -36,6 +40,10 @@ struct SemanticStats {
   std::int64_t dropped = 0;  // replaced by a newer frame before they were started, or failed
   std::int64_t failed = 0;   // segment() threw: nothing published for that frame
   std::string last_error;    // what() of the last failure
+  // With a pace: results published at each level, and how often the level changed.
+  std::vector<std::int64_t> processed_per_level;
+  int level_changes = 0;
+  int level = 0;  // the level in use now
 };
 
 // Runs a Segmenter on its own thread (paper Fig. 1: the semantic thread beside tracking).
@@ -49,6 +57,10 @@ class SemanticThread {
   using Clock = std::chrono::steady_clock;
 
   SemanticThread(std::unique_ptr<Segmenter> segmenter, const SemanticParams& params);
+  // Several segmenters (largest input first, the same classes) under a pace that picks which one
+  // runs and how sparsely (SemanticPace); without a pace the first one runs on every frame.
+  SemanticThread(std::vector<std::unique_ptr<Segmenter>> segmenters, const SemanticParams& params,
+                 std::optional<SemanticPace> pace);
   ~SemanticThread();
   SemanticThread(const SemanticThread&) = delete;
   SemanticThread& operator=(const SemanticThread&) = delete;
@@ -72,6 +84,10 @@ class SemanticThread {
   void stop();
 
   SemanticStats stats() const;
+  // Frames the caller should skip between submissions: the pace's stride (1 without a pace).
+  int stride() const { return stride_.load(std::memory_order_relaxed); }
+  // The pace's level now (0 without a pace).
+  int level() const { return level_.load(std::memory_order_relaxed); }
 
  private:
   struct Pending {
@@ -82,8 +98,16 @@ class SemanticThread {
   };
 
   void run();
+  // Segments `job` with the level's network (and the injected delay); throws what segment() does.
+  void segment(const Pending& job, SemanticResult& result);
+  // Publishes a finished result and lets the pace choose the next level.
+  void publish(std::shared_ptr<SemanticResult> result);
 
-  std::unique_ptr<Segmenter> segmenter_;
+  std::vector<std::unique_ptr<Segmenter>> segmenters_;
+  std::optional<SemanticPace> pace_;  // touched by the worker only, stats under mutex_
+  SemanticDelayDraw delay_;
+  std::atomic<int> stride_{1};
+  std::atomic<int> level_{0};
   std::vector<int> dynamic_ids_;
   int dilation_px_;
   size_t queue_size_;

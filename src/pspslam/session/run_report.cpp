@@ -13,6 +13,8 @@
 #include "pspslam/core/version.h"
 #include "pspslam/eval/ate.h"
 #include "pspslam/eval/stats.h"
+#include "pspslam/semantic/segmenter_metadata.h"
+#include "pspslam/semantic/semantic_pace.h"
 #include "pspslam/session/frame_log.h"
 
 namespace pspslam {
@@ -44,6 +46,77 @@ void print_loop_stats(const MappingStats& mapping, bool monocular, std::ostream&
                 mapping.global_ba_applied, mapping.global_ba_aborted,
                 mapping.last_global_ba_seconds);
   out << line;
+}
+
+// "pspnet.yaml (384x288)" for a segmentation model; the file name alone when it does not load.
+std::string describe_model(const std::filesystem::path& model) {
+  try {
+    const SegmenterMetadata meta = load_segmenter_metadata(model);
+    return model.filename().string() + " (" + std::to_string(meta.input_width) + "x" +
+           std::to_string(meta.input_height) + ")";
+  } catch (const Error&) {
+    return model.filename().string();
+  }
+}
+
+// A live run's masks: how many frames ran on a stale mask, how masks were moved, and what the
+// semantic thread stepped down to. Printed, and a stats.json member (null for other runs).
+nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostream& out) {
+  const DynamicOptions& dynamic = input.options.system.dynamic;
+  const RunStatistics& stats = input.statistics;
+  if (!dynamic.realtime || !uses_semantics(dynamic.mode) || !dynamic.semantic_masks.empty())
+    return nullptr;
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "live masks:   %zu frames on a mask older than %d frames; stale masks moved by "
+                "%s (%zu frames by the people's flow), %zu frames with the geometry test "
+                "tightened around them, %zu poses held at the motion model\n",
+                stats.frames_on_stale_mask, stats.stale_mask_frames(),
+                dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography",
+                stats.frames_mask_moved_by_flow, stats.frames_geometry_tightened,
+                stats.frames_pose_held);
+  out << line;
+  nlohmann::ordered_json json = {
+      {"stale_after_frames", stats.stale_mask_frames()},
+      {"frames_on_stale_mask", stats.frames_on_stale_mask},
+      {"stale_masks", dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography"},
+      {"frames_mask_moved_by_flow", stats.frames_mask_moved_by_flow},
+      {"frames_geometry_tightened", stats.frames_geometry_tightened},
+      {"frames_pose_held", stats.frames_pose_held},
+      {"pace", nullptr}};
+  if (!dynamic.keep_pace) return json;
+  const std::vector<std::filesystem::path> networks =
+      dynamic.smaller_model.empty()
+          ? std::vector<std::filesystem::path>{dynamic.model}
+          : std::vector<std::filesystem::path>{dynamic.model, dynamic.smaller_model};
+  const std::vector<PaceLevel> ladder =
+      pace_ladder(static_cast<int>(networks.size()), std::max(1, dynamic.pace_max_stride));
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  std::string text;
+  for (size_t i = 0; i < ladder.size(); ++i) {
+    const auto at = [&](const std::vector<size_t>& counts) {
+      return i < counts.size() ? counts[i] : size_t{0};
+    };
+    const std::string network = describe_model(networks[static_cast<size_t>(ladder[i].network)]);
+    levels.push_back({{"level", i},
+                      {"network", network},
+                      {"stride", ladder[i].stride},
+                      {"frames", at(stats.frames_at_pace_level)},
+                      {"frames_masked_at_level", at(stats.masks_at_pace_level)}});
+    text += (i ? ", " : "") + std::to_string(i) + " " + network + " every " +
+            (ladder[i].stride == 1 ? std::string("frame")
+                                   : std::to_string(ladder[i].stride) + " frames") +
+            ": " + std::to_string(at(stats.frames_at_pace_level));
+  }
+  const size_t stepped_down =
+      stats.processed() -
+      (stats.frames_at_pace_level.empty() ? stats.processed() : stats.frames_at_pace_level[0]);
+  out << "semantic pace: frames at each level: " << text << "; " << stats.pace_level_changes
+      << " level changes" << (stepped_down > 0 ? "" : " (never stepped down)") << "\n";
+  json["pace"] = {{"levels", levels},
+                  {"level_changes", stats.pace_level_changes},
+                  {"frames_stepped_down", stepped_down}};
+  return json;
 }
 
 // Blackout: how soon a pose came back, and how good the poses after the return are (errors of
@@ -248,6 +321,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                   arrival.median, arrival.p99, arrival.max, arrival.count);
     out << line;
   }
+  const nlohmann::ordered_json live_masks = report_live_masks(input, out);
   const FrameSourceStats source = input.source.stats();
   if (source.disconnected) out << "input:        " << source.end_reason << "\n";
 
@@ -303,13 +377,14 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                      {"culled_map_points", stats.culled_points},
                      {"frames_without_mask", stats.frames_without_mask}};
   json["mask_latency"] = {{"frames", to_json(mask_age)}, {"ms", to_json(mask_latency)}};
-  // Issue #18's real-time targets from the camera's point of view: a frame is tracked before the
+  if (!live_masks.is_null()) json["live_masks"] = live_masks;
+  // The real-time targets from the camera's point of view: a frame is tracked before the
   // next one arrives (arrival to pose, ms; empty without --realtime or a camera) and the mask it
   // used is at most 2 frames old (frames between the masked frame and this one).
   const LatencySummary arrival_to_pose = summarize_latency(stats.arrival_to_pose_ms);
   json["latency"] = {{"arrival_to_pose_ms", to_json(arrival_to_pose)},
                      {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
-  // How the threads shared the cores (issue #18 item 1's levers), to read beside the latency.
+  // How the threads shared the cores, to read beside the latency.
   json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
                         {"opencv_threads", cv::getNumThreads()},
                         {"blas_threads", blas_threads()},

@@ -118,11 +118,31 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     geometry_ms.push_back(dyn.geometry_ms);
     geometry_search_ms.push_back(dyn.geometry_search_ms);
   }
+  add_live_masks(dyn);
+  if (result.pose_held) ++frames_pose_held;
   tested_points += dyn.tested_points;
   dynamic_points += dyn.dynamic_points;
   masked_keypoints += dyn.masked_keypoints;
   culled_points += dyn.culled_map_points;
   ++processed_;
+}
+
+void RunStatistics::add_live_masks(const DynamicReport& dynamic) {
+  if (dynamic.mask_age_frames > stale_mask_frames_) ++frames_on_stale_mask;
+  if (dynamic.mask_moved_by_flow) ++frames_mask_moved_by_flow;
+  if (dynamic.geometry_tightened) ++frames_geometry_tightened;
+  const auto count = [](std::vector<size_t>& counts, int level) {
+    if (level < 0) return;
+    if (counts.size() <= static_cast<size_t>(level)) counts.resize(static_cast<size_t>(level) + 1);
+    ++counts[static_cast<size_t>(level)];
+  };
+  count(frames_at_pace_level, dynamic.semantic_pace_level);
+  count(masks_at_pace_level, dynamic.semantic_level);
+  if (dynamic.semantic_pace_level >= 0) {
+    if (last_pace_level_ >= 0 && dynamic.semantic_pace_level != last_pace_level_)
+      ++pace_level_changes;
+    last_pace_level_ = dynamic.semantic_pace_level;
+  }
 }
 
 }  // namespace pspslam

@@ -23,7 +23,7 @@ struct TimingSummary {
 TimingSummary summarize(std::vector<double> values);
 nlohmann::ordered_json to_json(const TimingSummary& timing);
 
-// The real-time figures of issue #18: median, p99 and max of a per-frame series (nearest-rank on
+// The real-time figures: median, p99 and max of a per-frame series (nearest-rank on
 // the sorted values, the same rule as TimingSummary's p95).
 struct LatencySummary {
   double median = 0.0;
@@ -38,8 +38,9 @@ nlohmann::ordered_json to_json(const LatencySummary& latency);
 // frames, relocalisations and (with a blackout) when poses came back. Read by run_report.h.
 class RunStatistics {
  public:
-  RunStatistics(DynamicMode mode, std::optional<FrameRange> blackout)
-      : mode_(mode), blackout_(blackout) {}
+  // `stale_mask_frames`: a mask older than this many frames counts as stale.
+  RunStatistics(DynamicMode mode, std::optional<FrameRange> blackout, int stale_mask_frames = 2)
+      : mode_(mode), blackout_(blackout), stale_mask_frames_(stale_mask_frames) {}
 
   // Frame `index` of the sequence; `local_ba_ms` = local BA time finished since the frame
   // before (0: none).
@@ -96,10 +97,26 @@ class RunStatistics {
   size_t masked_keypoints = 0;
   size_t culled_points = 0;
   size_t frames_without_mask = 0;
+  // Live runs: frames whose mask was older than stale_mask_frames, whose mask moved by the
+  // people's own flow, and whose geometry stage tested every keypoint near a stale mask.
+  size_t frames_on_stale_mask = 0;
+  size_t frames_mask_moved_by_flow = 0;
+  size_t frames_geometry_tightened = 0;
+  size_t frames_pose_held = 0;  // poses held at the motion model's prediction (MoverGuard)
+  // With a semantic pace: frames processed while the thread was at each level, and frames whose
+  // mask was made at each level (index = level); how often the thread changed level.
+  std::vector<size_t> frames_at_pace_level;
+  std::vector<size_t> masks_at_pace_level;
+  size_t pace_level_changes = 0;
+  int stale_mask_frames() const { return stale_mask_frames_; }
 
  private:
+  void add_live_masks(const DynamicReport& dynamic);
+
   DynamicMode mode_;
   std::optional<FrameRange> blackout_;
+  int stale_mask_frames_ = 2;
+  int last_pace_level_ = -1;
   size_t processed_ = 0;
   size_t lost_ = 0;
   size_t relocalisations_ = 0;

@@ -71,7 +71,8 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
       frames_(input_.source->frame_count().value_or(options_.max_frames)),
       log_(options_.outputs.folder),
       images_(options_.outputs.masks, options_.outputs.overlays),
-      statistics_(options_.system.dynamic.mode, options_.blackout) {
+      statistics_(options_.system.dynamic.mode, options_.blackout,
+                  options_.system.dynamic.stale_mask_frames) {
   const SystemOptions& system = options_.system;
   const DynamicOptions& dynamic = system.dynamic;
   if (options_.max_frames > 0 && (frames_ == 0 || frames_ > options_.max_frames))
@@ -103,6 +104,9 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
   // The config as the run uses it (a --sensor override applied; the original's comments are not
   // kept): `pspslam run --config OUT/run_config.yaml` repeats the run.
   save_config(options_.outputs.folder / "run_config.yaml", input_.config);
+  // The semantic thread's frame budget in live runs is the camera's frame period.
+  if (input_.config.camera.fps > 0.0)
+    options_.system.dynamic.frame_period_ms = 1000.0 / input_.config.camera.fps;
   system_ = std::make_unique<System>(input_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(input_.config.camera.pinhole);

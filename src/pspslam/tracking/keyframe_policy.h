@@ -13,32 +13,26 @@ struct KeyFramePolicyOptions {
   int close_untracked_min = 70;   // ... and more untracked close ones: need a keyframe
   // A keyframe is wanted when the frame tracks fewer than this share of the reference keyframe's
   // points (ORB-SLAM2: 0.75 for RGB-D). Denser keyframes lower the ATE of a slow hand-held camera
-  // at more local BA time: bonn_crowd_dev `full` 0.75 / 0.85 / 0.9 / 0.95 -> 22.0 / 18.7 / 16.6 /
-  // 16.8 mm, synthetic static 600 frames 0.75 / 0.85 / 0.9 -> 4.2 / 3.3 / 3.2 mm
-  // (docs/benchmarks.md, SLAM core; `pspslam run --keyframe-ratio` sets it).
+  // at the price of more local BA time (docs/decisions/keyframe-policy.md; `pspslam run
+  // --keyframe-ratio` sets it).
   double tracked_ratio_to_reference = 0.9;
   double tracked_ratio_to_reference_first_keyframes = 0.4;  // while the map has < 2 keyframes
   // A keyframe once max_frames_between frames have passed, whatever the ratio says. ORB-SLAM2
   // gates even a due keyframe on the ratio, and its reference count (the reference keyframe's
   // points seen by >= 3 keyframes) shrinks with the keyframe density itself on a camera that
   // keeps exploring: sparser keyframes, fewer points seen by three of them, a lower threshold,
-  // sparser keyframes. On the synthetic loop (bench/run_loop.sh) keyframes were inserted at ~400
-  // tracked points in the first 300 frames and at ~110 later, 1.4-2.4 s apart, and the frames in
-  // between, tracked from an ageing local map, ended 6.5 mm RMS off after loop closing against
-  // 3.3 mm at the keyframes (docs/benchmarks.md, #15 item 5); with this on, 2.8-4.0 mm with loop
-  // closing and 6.8-10.4 mm without on four loop sequences, against 5.1-7.2 and 13.8-20.1 mm. Off
-  // by default: on the real clip it moves the final trajectory by tenths of a millimetre, more
-  // often up than down (6 of 9 dev cells worse, online within 0.1 mm), and one cell fewer has its
-  // keyframes after BA closer to the truth than online (docs/benchmarks.md, sixteenth session).
-  // `pspslam run --due-keyframes` sets it.
+  // sparser keyframes. Without this rule the frames between sparse keyframes, tracked from an
+  // ageing local map, end well off the keyframes; with it loop sequences gain. Off by default: on
+  // the real clip it is not a clear gain (docs/decisions/due-keyframes.md). `pspslam run
+  // --due-keyframes` sets it.
   bool insert_when_due = false;
   // A wanted keyframe (the ratio test) is also inserted while the mapper is busy, as long as
   // nothing waits in its queue; the bundle adjustment in progress is cut short for it. ORB-SLAM2
   // waits for an idle mapper unless a keyframe is due or tracking is weak. A deterministic run
   // always meets an idle mapper (it waits for local mapping), so this changes nothing there; a
-  // real-time run rarely did, and made a third fewer keyframes than the same clip run
-  // deterministically (bonn_crowd_dev `full`: 46-50 against 71); with this on, it won the online
-  // ATE in 9 of 10 interleaved pairs (docs/benchmarks.md, issue #18 item 1).
+  // real-time run rarely meets one and would make far fewer keyframes than a deterministic run of
+  // the same clip; inserting while mapping keeps them dense and lowers the online ATE
+  // (docs/decisions/realtime-nice.md).
   bool insert_while_mapping = true;
 };
 

@@ -49,6 +49,7 @@ Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
     : map_(map),
       sink_(sink),
       options_(std::move(options)),
+      mover_guard_(options_.mover_guard),
       local_map_(options_.max_local_keyframes),
       initializer_(initializer ? std::move(initializer)
                                : make_depth_map_initializer(options_.min_initial_depth_points)) {
@@ -75,6 +76,7 @@ TrackResult Tracker::track(Frame frame) {
   } else {
     if (last_frame_) replace_replaced_points(*last_frame_);
     motion_prior_.reset();
+    predicted_pose_.reset();
     bool ok = false;
     if (state_ == TrackingState::kOk && velocity_ && last_frame_ && last_frame_->has_pose()) {
       ok = track_with_motion_model(frame);
@@ -104,6 +106,7 @@ TrackResult Tracker::track(Frame frame) {
       for (int i = 0; i < frame.size(); ++i) {
         if (frame.map_points[i] && !frame.outlier[i]) ++result.num_inliers;
       }
+      guard_against_movers(frame, result);
       maybe_insert_keyframe(frame, result);
     } else {
       state_ = TrackingState::kLost;
@@ -250,6 +253,7 @@ int Tracker::optimize_frame_pose(Frame& frame) {
 
 bool Tracker::track_with_motion_model(Frame& frame) {
   frame.set_pose(orthonormalized(*velocity_ * last_frame_->T_camera_world()));
+  predicted_pose_ = frame.T_camera_world();
   if (options_.motion_prior_sigma_rotation > 0.0 && options_.motion_prior_sigma_translation > 0.0)
     motion_prior_ = PosePrior{frame.T_camera_world(), options_.motion_prior_sigma_rotation,
                               options_.motion_prior_sigma_translation};
@@ -264,6 +268,18 @@ bool Tracker::track_with_motion_model(Frame& frame) {
   if (matches < options_.min_motion_matches) return false;
   optimize_frame_pose(frame);
   return discard_outliers(frame) >= options_.min_pose_inliers;
+}
+
+void Tracker::guard_against_movers(Frame& frame, TrackResult& result) {
+  if (!options_.mover_guard.enabled) return;
+  if (result.method != TrackingMethod::kMotionModel || !predicted_pose_) {
+    mover_guard_.reset();
+    return;
+  }
+  if (mover_guard_.should_hold(result.num_inliers, frame.T_camera_world(), *predicted_pose_)) {
+    frame.set_pose(*predicted_pose_);
+    result.pose_held = true;
+  }
 }
 
 bool Tracker::track_reference_keyframe(Frame& frame, bool recovering) {

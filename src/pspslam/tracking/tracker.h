@@ -13,6 +13,7 @@
 #include "pspslam/tracking/keyframe_policy.h"
 #include "pspslam/tracking/local_map.h"
 #include "pspslam/tracking/map_initializer.h"
+#include "pspslam/tracking/mover_guard.h"
 #include "pspslam/tracking/relocalizer.h"
 
 namespace pspslam {
@@ -40,19 +41,18 @@ struct TrackerOptions {
   PoseOptimizerOptions pose_optimizer;
   // A frame tracked with the motion model is optimised with the constant-velocity prediction as a
   // Gaussian prior of these σs (rad, m; 0 = no prior; `pspslam run --motion-prior MM DEG`). Off:
-  // on the accuracy panel (docs/benchmarks.md, #15 item 4) 3 mm / 0.15° lowered the online
-  // trajectory's frame-to-frame jitter in 13 of 13 cells (median −0.8 mm) but not its ATE (7 wins,
-  // 8 losses), and 1 mm / 0.05° raised the ATE by 2–4 mm: the prior trades jitter for wander.
+  // the prior lowers the online trajectory's frame-to-frame jitter but not its ATE, and tight σs
+  // raise the ATE: it trades jitter for wander.
   double motion_prior_sigma_rotation = 0.0;
   double motion_prior_sigma_translation = 0.0;
   // Rolling-shutter cameras: how far (rad/s) a frame's rotation rate may be from the previous
   // frame's before the image must show it (the prior of optimize/rolling_shutter_pose.h): 0.03
-  // rad/s in 33 ms is a hand-held angular acceleration of ~50 deg/s^2. 0.1 let the weakly seen
-  // tilt rate follow noise (Bonn: 12 deg/s rms measured where the poses turn at 4) and lost the
-  // dev-clip panel's final trajectory in 6 of 9 cells; 0.03 won 9 of 9 online, 6 of 9 final
-  // (docs/benchmarks.md, "Rolling shutter").
+  // rad/s in 33 ms is a hand-held angular acceleration of ~50 deg/s^2. A looser prior lets the
+  // weakly seen tilt rate follow noise (docs/decisions/rolling-shutter.md).
   double rotation_rate_sigma = 0.03;
   RelocalizerOptions relocalizer;
+  // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).
+  MoverGuardOptions mover_guard;
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
@@ -97,6 +97,9 @@ struct TrackResult {
   // Tracking was lost while the map was this young (MapInitializer::restart_when_lost_below):
   // the caller stops local mapping's work and calls Tracker::restart().
   bool restart_due = false;
+  // The pose is the motion model's prediction: the optimised one followed a moving cluster
+  // (MoverGuard).
+  bool pose_held = false;
 };
 
 // Tracking of each frame (ORB-SLAM2 semantics): map initialisation by the sensor's
@@ -167,6 +170,8 @@ class Tracker {
   bool relocalize(Frame& frame);
   bool track_local_map(Frame& frame);
   void maybe_insert_keyframe(Frame& frame, TrackResult& result);
+  // After a motion-model frame's pose is final: the prediction instead when MoverGuard says so.
+  void guard_against_movers(Frame& frame, TrackResult& result);
 
   // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
   int optimize_frame_pose(Frame& frame);
@@ -186,6 +191,9 @@ class Tracker {
   // The constant-velocity prediction of the frame being tracked, as a prior for its pose-only
   // optimisations (set only when it was tracked with the motion model and a prior is configured).
   std::optional<PosePrior> motion_prior_;
+  // The constant-velocity prediction of the frame being tracked with the motion model.
+  std::optional<Pose> predicted_pose_;
+  MoverGuard mover_guard_;
   std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
   std::shared_ptr<KeyFrame> reference_keyframe_;
   std::uint64_t last_keyframe_frame_id_ = 0;

@@ -33,9 +33,9 @@ struct TrackedFramePose {
 // Why not ORB-SLAM2's T_camera_reference * T_reference_world(now): that moves a frame only by
 // what its reference keyframe moved after the frame was tracked. Tracking errors of consecutive
 // frames are correlated (motion model, the same map points), so the whole correction BA applied
-// to a keyframe since it was tracked is the better estimate of its neighbours' errors. On
-// bonn_crowd_dev the reference-keyframe trajectory was worse than the tracked one; this one is
-// better (docs/benchmarks.md).
+// to a keyframe since it was tracked is the better estimate of its neighbours' errors. On real
+// sequences the reference-keyframe trajectory is worse than the tracked one and this one better
+// (docs/decisions/file-to-evaluate.md).
 // `frames` must be sorted by timestamp (and so by epoch).
 Trajectory refine_by_keyframe_corrections(std::span<const TrackedFramePose> frames);
 

@@ -166,13 +166,13 @@ def make_job(experiment, cell, variant, prepared, repeat, setup, cli, cli_sha256
                          else content.digest(prepared.config_text)),
               "arguments": [a.replace(str(prepared.folder), "SEQUENCE").replace(str(REPO), "REPO")
                             for a in command[1:]],
-              "env": variant.env, "repeat": repeat,
+              "env": variant.env, "busy_cores": variant.busy_cores, "repeat": repeat,
               "evaluations": sorted(s["id"] for s in prepared.stretches),
               "model_file": variant.model and content.file_sha256(REPO / variant.model)}
     return {"key": content.digest(recipe), "recipe": recipe, "kind": experiment.kind,
             "label": f"{cell.name} · {variant.name} · run {repeat + 1}", "command": command,
             "cwd": str(REPO), "env": {"PSPSLAM_SHARED": str(setup.shared), **variant.env},
-            "config_text": prepared.config_text,
+            "config_text": prepared.config_text, "busy_cores": variant.busy_cores,
             "stretches": prepared.stretches, "sequence": str(prepared.folder),
             "work": str(setup.work)}
 

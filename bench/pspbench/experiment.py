@@ -57,6 +57,7 @@ class Variant:
     env: dict = field(default_factory=dict)
     synth: dict = field(default_factory=dict)
     model: str | None = None  # segment: segmenter metadata YAML, relative to the repository
+    busy_cores: int = 0  # competitor load: processes spinning beside the run (scripts/busy-cores)
 
 
 @dataclass
@@ -242,7 +243,8 @@ def _read_variants(fields, modes):
                           config_set=_config_settings(item, "set"), build=item.get("build", str),
                           env={k: str(v) for k, v in item.get("env", dict, {}).items()},
                           synth=_synth_settings(item, "synth") if "synth" in item.table else {},
-                          model=item.get("model", str))
+                          model=item.get("model", str),
+                          busy_cores=item.get("busy_cores", int, 0))
         item.reject_unknown()
         if any(v.name == name for v in variants):
             raise table.error(name, f"variant '{name}' is also one of the modes")

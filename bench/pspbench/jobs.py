@@ -86,6 +86,10 @@ def measure_slam(job, attempt):
     if job["config_text"] is not None:
         (attempt / "config.yaml").write_text(job["config_text"])
         command += ["--config", str(attempt / "config.yaml")]
+    if job.get("busy_cores"):
+        # The competitor spins only while the run lasts and stops with it.
+        command = [str(Path(job["cwd"]) / "scripts" / "busy-cores"), "--cores",
+                   str(job["busy_cores"]), "--"] + command
     _execute(command, attempt, job["cwd"], job["env"])
     run = attempt / "run"
     stats = json.loads((run / "stats.json").read_text())

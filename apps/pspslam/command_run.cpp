@@ -15,7 +15,6 @@
 //   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,
 //                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)
-#include <spdlog/spdlog.h>
 #include <opencv2/core/utility.hpp>
 
 #include <chrono>
@@ -23,7 +22,6 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -39,11 +37,11 @@
 #include "pspslam/core/thread_priority.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/video_source.h"
-#include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/semantic/semantic_delay.h"
 #include "pspslam/session/run_options.h"
+#include "pspslam/session/run_settings.h"
 #include "pspslam/session/sequence_runner.h"
 #include "pspslam/viewer/live_viewer.h"
 
@@ -54,51 +52,6 @@ namespace {
 constexpr int kInterruptedExit = 130;
 // The whole sequence ran and no frame ever started a map: nothing was tracked.
 constexpr int kNeverStartedExit = 3;
-// Nice increment of the background threads in live runs (--background-nice): the caller thread
-// must track each frame before the next one arrives, so the background work yields the core
-// (docs/decisions/realtime-nice.md).
-constexpr int kLiveBackgroundNice = 10;
-// Local BA window of live runs (--local-ba-keyframes): the best 10 covisible keyframes. On two
-// cores the whole covisible set of a small room leaves local BA cut short, and the capped window
-// keeps up. Offline runs keep ORB-SLAM2's whole window, which gives the better final trajectory.
-constexpr int kLiveLocalBaKeyframes = 10;
-
-// Picks the dynamic mode. `auto` = full when the segmentation model can be loaded, else geometry
-// with a warning that says which model is missing and how to get it; an explicitly requested
-// semantic mode with a missing model is an error. With masks from files (`--semantic-masks`) no
-// model is needed, but a mode that uses them is.
-DynamicMode choose_mode(const std::string& flag_value, const std::filesystem::path& model,
-                        bool explicit_model, bool masks_from_files) {
-  const bool automatic = flag_value == "auto";
-  const DynamicMode wanted =
-      automatic ? DynamicMode::full : parse_dynamic_mode(flag_value, "--dynamic");
-  if (masks_from_files) {
-    if (!uses_semantics(wanted)) {
-      throw Error("--semantic-masks replaces the network's masks, but --dynamic " + flag_value +
-                  " uses none (use semantic, full or exhaustive)");
-    }
-    return wanted;
-  }
-  if (!uses_semantics(wanted)) return wanted;
-  try {
-    load_segmenter_metadata(model);
-    return wanted;
-  } catch (const Error& e) {
-    const std::string how =
-        "segmentation model not usable: " + std::string(e.what()) +
-        "\n  get it: train/export our PSPNet with tools/pspnet (models/pspnet/pspnet.yaml + "
-        ".onnx),\n  or pass a teacher, e.g. --model models/teachers/deeplabv3_mnv2_pascal.yaml "
-        "(ONNX in ../shared/models)";
-    if (!automatic || explicit_model) throw Error("--dynamic " + flag_value + ": " + how);
-    spdlog::warn("{}\n  falling back to --dynamic geometry", how);
-    return DynamicMode::geometry;
-  }
-}
-
-// `--loop-closing on|off|auto`: auto = on when the vocabulary file exists.
-bool parse_loop_closing(const std::string& value, const std::filesystem::path& vocabulary) {
-  return value == "on" || (value == "auto" && std::filesystem::exists(vocabulary));
-}
 
 // `--blackout FROM:COUNT`: frames FROM .. FROM+COUNT-1 are fed as black images without depth,
 // so tracking is really lost (relocalisation tests and demos).
@@ -183,11 +136,58 @@ struct RunFlags {
   int viewer_interval_ms = 250;
 };
 
-// A path the user typed is relative to the current folder; only the built-in defaults are found
-// next to the program.
-std::filesystem::path user_or_default(const std::string& typed,
-                                      const std::filesystem::path& shipped) {
-  return typed.empty() ? shipped : std::filesystem::path(typed);
+// A path the user typed (relative to the current folder); empty: the run's default.
+std::optional<std::filesystem::path> typed_path(const std::string& typed) {
+  if (typed.empty()) return std::nullopt;
+  return std::filesystem::path(typed);
+}
+
+// The flags that shape the System, as the library's RunSettings.
+RunSettings run_settings(const RunFlags& flags) {
+  RunSettings settings;
+  settings.mode = flags.dynamic;
+  settings.model = typed_path(flags.model);
+  settings.vocabulary = typed_path(flags.vocabulary);
+  settings.semantic_masks = typed_path(flags.semantic_masks);
+  settings.load_map = typed_path(flags.load_map);
+  settings.localization = flags.localization;
+  settings.realtime = flags.realtime;
+  settings.live_camera = !flags.camera.empty();
+  settings.local_mapping = !flags.no_local_mapping;
+  settings.relocalization = !flags.no_relocalization;
+  settings.loop_closing = flags.loop_closing;
+  settings.mask_margin = flags.mask_margin;
+  settings.segment_every = flags.segment_every;
+  settings.cull_hits = flags.cull_hits;
+  settings.keyframe_ratio = flags.keyframe_ratio;
+  settings.due_keyframes = flags.due_keyframes;
+  if (flags.local_ba_keyframes >= 0) settings.local_ba_keyframes = flags.local_ba_keyframes;
+  if (flags.background_nice >= 0) settings.background_nice = flags.background_nice;
+  if (flags.motion_prior.size() == 2)
+    settings.motion_prior = std::pair(flags.motion_prior[0], flags.motion_prior[1]);
+  return settings;
+}
+
+// The flags only `pspslam run` has (semantic pacing, stale masks, mover guard, fault injection);
+// the Python module keeps their defaults.
+void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
+  DynamicOptions& dynamic = system.dynamic;
+  dynamic.keep_pace = flags.semantic_pace == "on";
+  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
+  if (!flags.smaller_model.empty())
+    dynamic.smaller_model = flags.smaller_model;
+  else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
+    dynamic.smaller_model = shipped_smaller;
+  system.tracker.mover_guard.enabled = flags.mover_guard == "on";
+  dynamic.tighten_geometry = flags.stale_geometry == "on";
+  dynamic.propagation.max_growth_px = flags.stale_mask_growth;
+  dynamic.stale_masks =
+      flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
+  if (!flags.semantic_delay.empty()) {
+    dynamic.semantic.injected_delay =
+        parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
+    dynamic.semantic.injected_delay.seed = flags.semantic_delay_seed;
+  }
 }
 
 int run_slam(const RunFlags& flags, const GlobalOptions& global) {
@@ -212,60 +212,16 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
 
+  const RunSettings settings = run_settings(flags);
+  options.system = system_options(settings);
   SystemOptions& system = options.system;
-  DynamicOptions& dynamic = system.dynamic;
-  dynamic.model = user_or_default(flags.model, data_dir() / "models/pspnet/pspnet.yaml");
-  dynamic.mode = choose_mode(flags.dynamic, dynamic.model, !flags.model.empty(),
-                             !flags.semantic_masks.empty());
-  dynamic.semantic_masks = flags.semantic_masks;
-  system.local_mapping = !flags.no_local_mapping;
-  const bool live = flags.realtime || !flags.camera.empty();
-  system.background_thread_nice =
-      flags.background_nice >= 0 ? flags.background_nice : (live ? kLiveBackgroundNice : 0);
   // OpenCV's pool is process-wide: with one thread the network runs on the (lowered) semantic
   // thread alone instead of borrowing workers that compete with tracking at full priority.
   if (flags.opencv_threads >= 0)
     cv::setNumThreads(flags.opencv_threads);
-  else if (live)
+  else if (settings.live())
     cv::setNumThreads(1);
-  system.tracker.keyframes.tracked_ratio_to_reference = flags.keyframe_ratio;
-  system.tracker.keyframes.insert_when_due = flags.due_keyframes;
-  system.local_ba_keyframes = flags.local_ba_keyframes >= 0 ? flags.local_ba_keyframes
-                              : live                        ? kLiveLocalBaKeyframes
-                                                            : 0;
-  if (flags.motion_prior.size() == 2) {
-    system.tracker.motion_prior_sigma_translation = flags.motion_prior[0] * 1e-3;
-    system.tracker.motion_prior_sigma_rotation = flags.motion_prior[1] * std::numbers::pi / 180.0;
-  }
-  dynamic.realtime = flags.realtime;
-  dynamic.semantic.mask_dilation_px = flags.mask_margin;
-  dynamic.segment_every = flags.segment_every;
-  dynamic.keep_pace = flags.semantic_pace == "on";
-  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
-  if (!flags.smaller_model.empty())
-    dynamic.smaller_model = flags.smaller_model;
-  else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
-    dynamic.smaller_model = shipped_smaller;
-  system.tracker.mover_guard.enabled = flags.mover_guard == "on";
-  dynamic.tighten_geometry = flags.stale_geometry == "on";
-  dynamic.propagation.max_growth_px = flags.stale_mask_growth;
-  dynamic.stale_masks =
-      flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
-  if (!flags.semantic_delay.empty()) {
-    dynamic.semantic.injected_delay =
-        parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
-    dynamic.semantic.injected_delay.seed = flags.semantic_delay_seed;
-  }
-  dynamic.culling.min_dynamic_hits = flags.cull_hits;
-  system.place.relocalization = !flags.no_relocalization;
-  if (!flags.load_map.empty()) {
-    system.map_file = flags.load_map;
-    system.localization_only = flags.localization;
-  }
-  system.place.vocabulary = user_or_default(flags.vocabulary, default_vocabulary_path());
-  // Localisation never changes the map, so it never closes loops (System turns it off too).
-  system.place.loop_closing =
-      !system.localization_only && parse_loop_closing(flags.loop_closing, system.place.vocabulary);
+  set_cli_only_options(flags, system);
 
   // A live camera, or the sequence folder (opened by the runner).
   std::optional<RunInput> camera;
@@ -287,9 +243,8 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   }
   // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
   // second of frames, so a live run without --realtime waits for local mapping only.
-  system.back_end_wait = flags.realtime                     ? BackEndWait::none
-                         : camera && camera->source->live() ? BackEndWait::local_mapping
-                                                            : BackEndWait::whole_back_end;
+  if (!flags.realtime && camera && camera->source->live())
+    system.back_end_wait = BackEndWait::local_mapping;
   // The viewer binds its address before the model and the sequence load, so a port in use is
   // told at once; it outlives the runner, which only points to it.
   std::unique_ptr<LiveViewer> viewer;
@@ -300,7 +255,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     live.interval = std::chrono::milliseconds(flags.viewer_interval_ms);
     live.start_paused = flags.viewer_paused;
     live.realtime = flags.realtime;
-    live.classes = overlay_classes(dynamic);
+    live.classes = overlay_classes(system.dynamic);
     live.title = !flags.video.empty()   ? "video " + flags.video
                  : flags.camera.empty() ? flags.sequence
                                         : "camera " + flags.camera;

@@ -69,7 +69,7 @@ PySystem::PySystem(SystemConfig config, std::string config_name, const RunSettin
                    bool keypoints)
     : config_(std::move(config)),
       config_name_(std::move(config_name)),
-      options_(system_options(settings)) {
+      options_(checked_system_options(settings)) {
   // As `pspslam run`: the linear algebra calls are small, a BLAS's spinning workers are not.
   use_single_threaded_blas();
   apply_sensor_limits(config_.camera.type, options_);

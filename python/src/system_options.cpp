@@ -3,22 +3,12 @@
 #include <pybind11/pybind11.h>
 
 #include <initializer_list>
-#include <numbers>
 #include <string>
-
-#include "pspslam/core/error.h"
-#include "pspslam/core/shared_paths.h"
-#include "pspslam/place/place_recognition.h"
-#include "pspslam/semantic/segmenter_metadata.h"
 
 namespace pspslam::python {
 namespace {
 
 namespace py = pybind11;
-
-// The values `pspslam run` gives live runs; Python runs are live only with realtime=True.
-constexpr int kLiveBackgroundNice = 10;
-constexpr int kLiveLocalBaKeyframes = 10;
 
 // A number as Python prints it (1e-3 as 0.001, 100 as 100).
 template <typename T>
@@ -43,22 +33,6 @@ void require_member(const std::string& value, std::initializer_list<const char*>
     listed += name;
   }
   throw py::value_error(std::string(keyword) + ": expected " + listed + ", got '" + value + "'");
-}
-
-// As `pspslam run --dynamic`: auto = full when the segmentation model loads, else geometry; a
-// semantic mode asked for by name needs its model (or masks from files).
-DynamicMode choose_mode(const RunSettings& settings, const std::filesystem::path& model) {
-  const bool automatic = settings.mode == "auto";
-  const DynamicMode wanted =
-      automatic ? DynamicMode::full : parse_dynamic_mode(settings.mode, "mode");
-  if (!uses_semantics(wanted) || settings.semantic_masks) return wanted;
-  try {
-    load_segmenter_metadata(model);
-    return wanted;
-  } catch (const Error& e) {
-    if (!automatic || settings.model) throw Error("mode " + settings.mode + ": " + e.what());
-    return DynamicMode::geometry;
-  }
 }
 
 void check_ranges(const RunSettings& settings) {
@@ -86,41 +60,12 @@ void check_ranges(const RunSettings& settings) {
 
 }  // namespace
 
-SystemOptions system_options(const RunSettings& settings) {
+SystemOptions checked_system_options(const RunSettings& settings) {
   check_ranges(settings);
-  SystemOptions system;
-  DynamicOptions& dynamic = system.dynamic;
-  dynamic.model = settings.model.value_or(data_dir() / "models/pspnet/pspnet.yaml");
-  dynamic.mode = choose_mode(settings, dynamic.model);
-  dynamic.semantic_masks = settings.semantic_masks.value_or(std::filesystem::path());
-  system.local_mapping = settings.local_mapping;
-  const bool live = settings.realtime;
-  system.background_thread_nice = settings.background_nice.value_or(live ? kLiveBackgroundNice : 0);
-  system.tracker.keyframes.tracked_ratio_to_reference = settings.keyframe_ratio;
-  system.tracker.keyframes.insert_when_due = settings.due_keyframes;
-  system.local_ba_keyframes =
-      settings.local_ba_keyframes.value_or(live ? kLiveLocalBaKeyframes : 0);
-  if (settings.motion_prior) {
-    system.tracker.motion_prior_sigma_translation = settings.motion_prior->first * 1e-3;
-    system.tracker.motion_prior_sigma_rotation =
-        settings.motion_prior->second * std::numbers::pi / 180.0;
-  }
-  dynamic.realtime = settings.realtime;
-  dynamic.semantic.mask_dilation_px = settings.mask_margin;
-  dynamic.segment_every = settings.segment_every;
-  dynamic.culling.min_dynamic_hits = settings.cull_hits;
-  system.place.relocalization = settings.relocalization;
-  if (settings.load_map) {
-    system.map_file = *settings.load_map;
-    system.localization_only = settings.localization;
-  }
-  system.place.vocabulary = settings.vocabulary.value_or(default_vocabulary_path());
-  system.place.loop_closing =
-      !system.localization_only &&
-      (settings.loop_closing == "on" ||
-       (settings.loop_closing == "auto" && std::filesystem::exists(system.place.vocabulary)));
-  system.back_end_wait = settings.realtime ? BackEndWait::none : BackEndWait::whole_back_end;
-  return system;
+  // The keywords' names; a model that does not load is raised as its own error.
+  const SettingNames names{
+      .mode = "mode", .semantic_masks = "semantic_masks", .explain_model = false};
+  return system_options(settings, names);
 }
 
 }  // namespace pspslam::python

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -7,6 +8,7 @@
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/session/frame_log.h"
 #include "pspslam/session/run_options.h"
+#include "pspslam/session/run_settings.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/session/start_watch.h"
 #include "support/test_support.h"
@@ -195,6 +197,82 @@ TEST(RunOutputs, PathsAreCheckedAndCreatedNamingTheFlag) {
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()).rfind("--export-map '", 0), 0u) << e.what();
   }
+}
+
+TEST(RunSettings, LiveRunsYieldTheCoreAndCapLocalBa) {
+  RunSettings settings;
+  settings.mode = "off";
+  const SystemOptions offline = system_options(settings);
+  EXPECT_EQ(offline.background_thread_nice, 0);
+  EXPECT_EQ(offline.local_ba_keyframes, 0);
+  EXPECT_EQ(offline.back_end_wait, BackEndWait::whole_back_end);
+  settings.realtime = true;
+  const SystemOptions realtime = system_options(settings);
+  EXPECT_EQ(realtime.background_thread_nice, kLiveBackgroundNice);
+  EXPECT_EQ(realtime.local_ba_keyframes, kLiveLocalBaKeyframes);
+  EXPECT_EQ(realtime.back_end_wait, BackEndWait::none);
+  EXPECT_TRUE(realtime.dynamic.realtime);
+  settings.realtime = false;
+  settings.live_camera = true;
+  settings.background_nice = 3;
+  const SystemOptions camera = system_options(settings);
+  EXPECT_EQ(camera.background_thread_nice, 3);
+  EXPECT_EQ(camera.local_ba_keyframes, kLiveLocalBaKeyframes);
+  EXPECT_FALSE(camera.dynamic.realtime);
+}
+
+TEST(RunSettings, LoopClosingAutoNeedsTheVocabularyAndNeverRunsInLocalisation) {
+  RunSettings settings;
+  settings.mode = "off";
+  settings.vocabulary = "/nonexistent/vocabulary.pspvoc";
+  EXPECT_FALSE(system_options(settings).place.loop_closing);
+  settings.loop_closing = "on";
+  EXPECT_TRUE(system_options(settings).place.loop_closing);
+  settings.load_map = "map.bin";
+  settings.localization = true;
+  const SystemOptions localisation = system_options(settings);
+  EXPECT_TRUE(localisation.localization_only);
+  EXPECT_FALSE(localisation.place.loop_closing);
+}
+
+// The message of the Error `call` throws; empty when it throws none.
+template <typename Call>
+std::string error_of(Call call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+TEST(RunSettings, AutoFallsBackToGeometryButANamedModeNeedsItsModel) {
+  const std::filesystem::path missing = "/nonexistent/model.yaml";
+  RunSettings settings;
+  EXPECT_EQ(choose_mode(settings, missing), DynamicMode::geometry);
+  settings.model = missing;
+  EXPECT_THROW(choose_mode(settings, missing), Error);
+  settings.model.reset();
+  settings.mode = "full";
+  const std::string cli = error_of([&] { choose_mode(settings, missing); });
+  EXPECT_EQ(cli.rfind("--dynamic full: segmentation model not usable: ", 0), 0u) << cli;
+  const SettingNames keywords{
+      .mode = "mode", .semantic_masks = "semantic_masks", .explain_model = false};
+  const std::string python = error_of([&] { choose_mode(settings, missing, keywords); });
+  EXPECT_EQ(python.rfind("mode full: ", 0), 0u) << python;
+  EXPECT_EQ(python.find("get it"), std::string::npos) << python;
+}
+
+TEST(RunSettings, MasksFromFilesNeedAModeThatUsesThem) {
+  const std::filesystem::path missing = "/nonexistent/model.yaml";
+  RunSettings settings;
+  settings.semantic_masks = "masks";
+  settings.mode = "semantic";
+  EXPECT_EQ(choose_mode(settings, missing), DynamicMode::semantic);
+  settings.mode = "geometry";
+  EXPECT_EQ(error_of([&] { choose_mode(settings, missing); }),
+            "--semantic-masks replaces the network's masks, but --dynamic geometry uses none "
+            "(use semantic, full or exhaustive)");
 }
 
 }  // namespace

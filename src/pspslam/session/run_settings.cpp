@@ -1,0 +1,104 @@
+#include "pspslam/session/run_settings.h"
+
+#include <spdlog/spdlog.h>
+
+#include <numbers>
+#include <string>
+
+#include "pspslam/core/error.h"
+#include "pspslam/core/shared_paths.h"
+#include "pspslam/place/place_recognition.h"
+#include "pspslam/semantic/segmenter_metadata.h"
+
+namespace pspslam {
+namespace {
+
+// Why the model does not load, with how to get one where the caller explains it.
+std::string model_problem(const Error& e, const SettingNames& names) {
+  if (!names.explain_model) return e.what();
+  return "segmentation model not usable: " + std::string(e.what()) +
+         "\n  get it: train/export our PSPNet with tools/pspnet (models/pspnet/pspnet.yaml + "
+         ".onnx),\n  or pass a teacher, e.g. --model models/teachers/deeplabv3_mnv2_pascal.yaml "
+         "(ONNX in ../shared/models)";
+}
+
+// `loop_closing` on | off | auto: auto = on when the vocabulary file exists.
+bool wants_loop_closing(const std::string& value, const std::filesystem::path& vocabulary) {
+  return value == "on" || (value == "auto" && std::filesystem::exists(vocabulary));
+}
+
+void set_tracking(const RunSettings& settings, SystemOptions& system) {
+  system.tracker.keyframes.tracked_ratio_to_reference = settings.keyframe_ratio;
+  system.tracker.keyframes.insert_when_due = settings.due_keyframes;
+  if (settings.motion_prior) {
+    system.tracker.motion_prior_sigma_translation = settings.motion_prior->first * 1e-3;
+    system.tracker.motion_prior_sigma_rotation =
+        settings.motion_prior->second * std::numbers::pi / 180.0;
+  }
+}
+
+void set_dynamic(const RunSettings& settings, const SettingNames& names, DynamicOptions& dynamic) {
+  dynamic.model = settings.model.value_or(data_dir() / "models/pspnet/pspnet.yaml");
+  dynamic.mode = choose_mode(settings, dynamic.model, names);
+  dynamic.semantic_masks = settings.semantic_masks.value_or(std::filesystem::path());
+  dynamic.realtime = settings.realtime;
+  dynamic.semantic.mask_dilation_px = settings.mask_margin;
+  dynamic.segment_every = settings.segment_every;
+  dynamic.culling.min_dynamic_hits = settings.cull_hits;
+}
+
+void set_place(const RunSettings& settings, SystemOptions& system) {
+  system.place.relocalization = settings.relocalization;
+  if (settings.load_map) {
+    system.map_file = *settings.load_map;
+    system.localization_only = settings.localization;
+  }
+  system.place.vocabulary = settings.vocabulary.value_or(default_vocabulary_path());
+  // Localisation never changes the map, so it never closes loops (System turns it off too).
+  system.place.loop_closing = !system.localization_only &&
+                              wants_loop_closing(settings.loop_closing, system.place.vocabulary);
+}
+
+}  // namespace
+
+DynamicMode choose_mode(const RunSettings& settings, const std::filesystem::path& model,
+                        const SettingNames& names) {
+  const bool automatic = settings.mode == "auto";
+  const DynamicMode wanted =
+      automatic ? DynamicMode::full : parse_dynamic_mode(settings.mode, names.mode);
+  if (settings.semantic_masks) {
+    if (!uses_semantics(wanted)) {
+      throw Error(std::string(names.semantic_masks) + " replaces the network's masks, but " +
+                  names.mode + " " + settings.mode +
+                  " uses none (use semantic, full or exhaustive)");
+    }
+    return wanted;
+  }
+  if (!uses_semantics(wanted)) return wanted;
+  try {
+    load_segmenter_metadata(model);
+    return wanted;
+  } catch (const Error& e) {
+    const std::string problem = model_problem(e, names);
+    if (!automatic || settings.model)
+      throw Error(std::string(names.mode) + " " + settings.mode + ": " + problem);
+    if (names.explain_model) spdlog::warn("{}\n  falling back to {} geometry", problem, names.mode);
+    return DynamicMode::geometry;
+  }
+}
+
+SystemOptions system_options(const RunSettings& settings, const SettingNames& names) {
+  SystemOptions system;
+  set_dynamic(settings, names, system.dynamic);
+  system.local_mapping = settings.local_mapping;
+  const bool live = settings.live();
+  system.background_thread_nice = settings.background_nice.value_or(live ? kLiveBackgroundNice : 0);
+  system.local_ba_keyframes =
+      settings.local_ba_keyframes.value_or(live ? kLiveLocalBaKeyframes : 0);
+  set_tracking(settings, system);
+  set_place(settings, system);
+  system.back_end_wait = settings.realtime ? BackEndWait::none : BackEndWait::whole_back_end;
+  return system;
+}
+
+}  // namespace pspslam

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "pspslam/system/system.h"
+
+namespace pspslam {
+
+// Nice increment of the background threads in live runs: the caller thread must track each frame
+// before the next one arrives, so the background work yields the core
+// (docs/decisions/realtime-nice.md).
+inline constexpr int kLiveBackgroundNice = 10;
+// Local BA window of live runs: the best 10 covisible keyframes. On two cores the whole covisible
+// set of a small room leaves local BA cut short, and the capped window keeps up. Offline runs keep
+// ORB-SLAM2's whole window, which gives the better final trajectory.
+inline constexpr int kLiveLocalBaKeyframes = 10;
+
+// The run settings that shape the System: `pspslam run`'s flags and the Python module's keywords
+// of the same names, with their defaults. Empty optionals take the run's default.
+struct RunSettings {
+  std::string mode = "auto";  // off | semantic | geometry | full | exhaustive | auto
+  std::optional<std::filesystem::path> model;           // none: the shipped model
+  std::optional<std::filesystem::path> vocabulary;      // none: the shipped vocabulary
+  std::optional<std::filesystem::path> semantic_masks;  // none: the network segments the frames
+  std::optional<std::filesystem::path> load_map;
+  bool localization = false;  // used with load_map only
+  bool realtime = false;
+  bool live_camera = false;  // frames from a live camera: live as with realtime
+  bool local_mapping = true;
+  bool relocalization = true;
+  std::string loop_closing = "auto";  // on | off | auto
+  int mask_margin = 5;
+  int segment_every = 1;
+  int cull_hits = 3;
+  double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
+  bool due_keyframes = false;
+  std::optional<int> local_ba_keyframes;  // none: kLiveLocalBaKeyframes when live, else 0 (all)
+  std::optional<int> background_nice;     // none: kLiveBackgroundNice when live, else 0
+  std::optional<std::pair<double, double>> motion_prior;  // millimetres, degrees
+
+  // A live run must keep up with its frames, so its background work yields and its BA is capped.
+  bool live() const { return realtime || live_camera; }
+};
+
+// How a run's messages name its settings: the CLI's flags, or the Python keywords (an exception
+// with the model's own error is the whole message there, and auto falls back without a warning).
+struct SettingNames {
+  const char* mode = "--dynamic";
+  const char* semantic_masks = "--semantic-masks";
+  bool explain_model = true;  // say how to get a missing model; warn when auto falls back
+};
+
+// The dynamic mode the settings ask for: auto = full when the segmentation model loads, else
+// geometry; a semantic mode asked for by name needs its model, and masks from files need a mode
+// that uses them. Throws Error naming the setting otherwise.
+DynamicMode choose_mode(const RunSettings& settings, const std::filesystem::path& model,
+                        const SettingNames& names = {});
+
+// The SystemOptions of a run with these settings. Deterministic unless `realtime`: each frame
+// waits for its mask and the whole back end (a caller with a live camera may wait for less).
+SystemOptions system_options(const RunSettings& settings, const SettingNames& names = {});
+
+}  // namespace pspslam

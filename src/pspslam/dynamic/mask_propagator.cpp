@@ -5,18 +5,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "pspslam/core/median.h"
 #include "pspslam/geometry/compensated_homography.h"
 
 namespace pspslam {
 namespace {
-
-// Median of `values` (reordered); 0 for none.
-double median_of(std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 // Median valid depth (metres) inside `shape` over `box` of `depth`, every other pixel.
 double median_depth(const cv::Mat& depth, const cv::Rect& box, const cv::Mat& shape) {
@@ -29,7 +22,7 @@ double median_depth(const cv::Mat& depth, const cv::Rect& box, const cv::Mat& sh
       if (inside[x] && row[x] > 0.0f && std::isfinite(row[x])) values.push_back(row[x]);
     }
   }
-  return median_of(values);
+  return upper_median(values);
 }
 
 }  // namespace
@@ -166,7 +159,7 @@ cv::Point2d MaskPropagator::displacement(const Component& component,
     dy.push_back(component.now[i].y - component.origin[i].y);
   }
   by_flow = static_cast<int>(dx.size()) >= params_.min_tracked_corners;
-  if (by_flow) return {median_of(dx), median_of(dy)};
+  if (by_flow) return {upper_median(dx), upper_median(dy)};
   if (!H) return {0.0, 0.0};
   const Eigen::Vector2d at =
       transfer_point(*H, Eigen::Vector2d(component.centroid.x, component.centroid.y));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pspslam/core/error.h"
+#include "pspslam/core/median.h"
 #include "pspslam/core/thread_priority.h"
 #include "pspslam/core/version.h"
 #include "pspslam/eval/ate.h"
@@ -20,12 +21,7 @@
 namespace pspslam {
 namespace {
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
+double median(std::vector<double> values) { return upper_median(values); }
 
 void print_loop_stats(const MappingStats& mapping, bool monocular, std::ostream& out) {
   // A monocular map has no metric unit: the correction is in the map's units, and the loop

@@ -7,8 +7,8 @@
 
 #include "fuzz_input.h"
 #include "pspslam/core/checksum.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/map.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/synth/scene.h"
@@ -17,8 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace pspslam;
   if (size == 0) return 0;
   // The camera of `pspslam synth` sequences, which the seed maps were made with.
-  static const auto camera =
-      std::make_shared<const RgbdCamera>(RgbdCamera::from_config(synthetic_camera_config(), 0.08));
+  static const auto camera = std::make_shared<const CameraModel>(
+      CameraModel::from_config(synthetic_camera_config(), 0.08));
   static const auto pyramid =
       std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   const std::string_view body = fuzz::as_text(data + 1, size - 1);

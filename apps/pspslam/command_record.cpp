@@ -37,7 +37,7 @@ int record(const RecordFlags& flags, const GlobalOptions& global) {
             << (flags.frames > 0 ? std::to_string(flags.frames) + " frames" : "until Ctrl-C")
             << ", depth factor " << config.camera.depth_factor << ")\n";
   while (!interrupted() && (flags.frames == 0 || recorder.frames() < flags.frames)) {
-    const std::optional<RgbdFrame> frame = camera->next();
+    const std::optional<InputFrame> frame = camera->next();
     if (!frame) break;
     recorder.add(*frame);
     if (!global.quiet && recorder.frames() % 30 == 0)

@@ -96,7 +96,7 @@ void PySystem::require_running(const char* what) const {
 PyFrame PySystem::make_frame(const py::handle& image, const py::handle& depth,
                              const py::handle& right, const py::handle& timestamp) {
   const SensorType sensor = config_.camera.type;
-  auto frame = std::make_shared<RgbdFrame>();
+  auto frame = std::make_shared<InputFrame>();
   frame->timestamp = timestamp_value(timestamp);
   frame->depth_timestamp = frame->timestamp;
   const bool semantics = uses_semantics(options_.dynamic.mode);
@@ -131,7 +131,7 @@ void PySystem::check_next(const PyFrame& frame) const {
                           std::to_string(announced_.front()->timestamp) +
                           "): announced frames are tracked in the order announced");
   }
-  const RgbdFrame& f = *frame.frame;
+  const InputFrame& f = *frame.frame;
   const cv::Size camera(config_.camera.pinhole.width, config_.camera.pinhole.height);
   require_size(f.bgr, camera, "frame", "the camera's size in " + config_name_ + ",");
   if (announced_.empty()) require_after(last_timestamp_, f.timestamp);

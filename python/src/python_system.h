@@ -19,10 +19,10 @@ namespace pspslam::python {
 
 namespace py = pybind11;
 
-// One frame as Python sees it: the RgbdFrame the system reads, shared and never changed after it
+// One frame as Python sees it: the InputFrame the system reads, shared and never changed after it
 // is made (its arrays are read-only views).
 struct PyFrame {
-  std::shared_ptr<const RgbdFrame> frame;
+  std::shared_ptr<const InputFrame> frame;
 };
 
 // What track() returns: the frame's report and its final dynamic mask (shared with the system,
@@ -73,7 +73,7 @@ class PySystem {
   std::optional<Timestamp> last_timestamp_;  // of the last frame tracked or announced
   std::optional<Timestamp> last_tracked_;
   // Frames announced and not tracked yet, in order: track() must get them in that order.
-  std::deque<std::shared_ptr<const RgbdFrame>> announced_;
+  std::deque<std::shared_ptr<const InputFrame>> announced_;
   size_t next_index_ = 0;
 };
 

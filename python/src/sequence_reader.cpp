@@ -23,7 +23,7 @@ PyFrame PySequence::frame(size_t i) const {
     throw py::index_error("frame " + std::to_string(i) + " of a sequence of " +
                           std::to_string(frames_));
   py::gil_scoped_release release;
-  return {std::make_shared<const RgbdFrame>(setup_->sequence.load(i))};
+  return {std::make_shared<const InputFrame>(setup_->sequence.load(i))};
 }
 
 py::object PySequence::ground_truth() const {

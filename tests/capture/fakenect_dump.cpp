@@ -29,7 +29,7 @@ void write_fakenect_dump(const RgbdSequence& sequence, const std::filesystem::pa
   const size_t frames =
       options.frames == 0 ? sequence.size() : std::min(options.frames, sequence.size());
   for (size_t i = 0; i < frames; ++i) {
-    const RgbdFrame frame = sequence.load(i);
+    const InputFrame frame = sequence.load(i);
     if (frame.bgr.cols != 640 || frame.bgr.rows != 480)
       throw Error("fakenect plays 640x480 frames only");
     const double elapsed = sequence.timestamp(i) - sequence.timestamp(0);

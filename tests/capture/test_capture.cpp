@@ -183,7 +183,7 @@ TEST(SequenceRecorder, WritesATumSequenceThatReadsBackFramePerFrame) {
   {
     SequenceRecorder recorder(dir / "rec", config, 1000.0);
     for (int i = 0; i < 3; ++i) {
-      RgbdFrame frame;
+      InputFrame frame;
       frame.timestamp = 1700000000.5 + i / 30.0;
       frame.depth_timestamp = frame.timestamp + 0.004;
       frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar(10 * i, 20, 30));
@@ -200,7 +200,7 @@ TEST(SequenceRecorder, WritesATumSequenceThatReadsBackFramePerFrame) {
   const SequenceSetup setup = open_sequence_with_config(dir / "rec", std::nullopt, nullptr);
   EXPECT_EQ(setup.config.camera.depth_factor, 1000.0);
   ASSERT_EQ(setup.sequence.size(), 3u);
-  const RgbdFrame back = setup.sequence.load(2);
+  const InputFrame back = setup.sequence.load(2);
   EXPECT_EQ(back.name, "rgb/1700000000.566667.png");
   EXPECT_NEAR(back.timestamp, 1700000000.5 + 2 / 30.0, 1e-6);
   EXPECT_NEAR(back.depth_timestamp, back.timestamp + 0.004, 1e-6);
@@ -225,7 +225,7 @@ std::filesystem::path record_tiny_sequence(const std::filesystem::path& dir, int
                         << fps << "\n  depth_factor: 5000\n  depth_threshold: 3\n";
   SequenceRecorder recorder(dir / "seq", config, 5000.0);
   for (int i = 0; i < frames; ++i) {
-    RgbdFrame frame;
+    InputFrame frame;
     frame.timestamp = frame.depth_timestamp = 50.0 + i / static_cast<double>(fps);
     frame.bgr = cv::Mat(6, 8, CV_8UC3, cv::Scalar::all(grey_step * i));
     frame.depth = cv::Mat(6, 8, CV_32FC1, cv::Scalar(1.0f));
@@ -241,7 +241,7 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   EXPECT_EQ(all.frame_count(), 15u);
   EXPECT_EQ(all.name(), (dir / "seq").string());
   size_t count = 0;
-  while (const std::optional<RgbdFrame> frame = all.next()) {
+  while (const std::optional<InputFrame> frame = all.next()) {
     EXPECT_EQ(frame->index, count++);
     EXPECT_FALSE(frame->arrival) << "an unpaced frame has no arrival to measure latency from";
   }
@@ -254,7 +254,7 @@ TEST(SequenceSource, DeterministicGivesEveryFrameAndPacedDropsLateOnes) {
   size_t delivered = 0;
   size_t last = 0;
   std::optional<std::chrono::steady_clock::time_point> first_arrival;
-  while (const std::optional<RgbdFrame> frame = paced.next()) {
+  while (const std::optional<InputFrame> frame = paced.next()) {
     // A frame arrives when it is due (10 ms per frame from the first), even when the busy
     // consumer takes it later: that wait is part of its latency.
     ASSERT_TRUE(frame->arrival);
@@ -283,7 +283,7 @@ TEST(SequenceSource, PreloadedPacedSourceDeliversEveryFrameWhenDue) {
                         Preload::on);
   size_t delivered = 0;
   std::optional<std::chrono::steady_clock::time_point> first_arrival;
-  while (const std::optional<RgbdFrame> frame = source.next()) {
+  while (const std::optional<InputFrame> frame = source.next()) {
     EXPECT_EQ(frame->index, delivered);
     EXPECT_EQ(frame->bgr.at<cv::Vec3b>(0, 0)[0], 10 * delivered);
     ASSERT_TRUE(frame->arrival);

@@ -6,9 +6,9 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/dynamic/map_reference_views.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 
 namespace pspslam {
@@ -27,7 +27,7 @@ std::shared_ptr<KeyFrame> keyframe_with(std::uint64_t id, const Pose& T_world_ca
   data.depth = depths;
   return std::make_shared<KeyFrame>(
       id, std::move(data),
-      std::make_shared<const RgbdCamera>(RgbdCamera::from_config(camera, 0.08)),
+      std::make_shared<const CameraModel>(CameraModel::from_config(camera, 0.08)),
       std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{})));
 }
 

@@ -104,7 +104,7 @@ TEST(EurocSequence, ReadsRectifiesAndMovesTheGroundTruthOntoTheCamera) {
   // The baseline is the distance between the camera centres (0.11, 0.002, 0).
   EXPECT_NEAR(camera.baseline, std::hypot(0.11, 0.002), 1e-9);
   EXPECT_DOUBLE_EQ(camera.fps, 20.0);
-  const RgbdFrame frame = sequence.load(2);
+  const InputFrame frame = sequence.load(2);
   EXPECT_EQ(frame.right.size(), cv::Size(kWidth, kHeight));
   EXPECT_EQ(frame.gray.at<uint8_t>(kHeight / 2, kWidth / 2), 42);
   ASSERT_TRUE(sequence.ground_truth());

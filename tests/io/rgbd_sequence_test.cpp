@@ -74,7 +74,7 @@ TEST(RgbdSequence, AssociatesAndLoadsFrames) {
   EXPECT_FALSE(sequence.ground_truth().has_value());
   EXPECT_FALSE(sequence.config_path().has_value());
   EXPECT_DOUBLE_EQ(sequence.timestamp(2), 10.2);
-  const RgbdFrame frame = sequence.load(2);
+  const InputFrame frame = sequence.load(2);
   EXPECT_EQ(frame.index, 2u);
   EXPECT_DOUBLE_EQ(frame.timestamp, 10.2);
   EXPECT_DOUBLE_EQ(frame.depth_timestamp, 10.205);
@@ -90,7 +90,7 @@ TEST(RgbdSequence, DepthFactorIsApplied) {
   const auto dir = make_sequence("seq");
   SequenceOptions options;
   options.depth_factor = 1000.0;
-  const RgbdFrame frame = RgbdSequence::open(dir, options).load(0);
+  const InputFrame frame = RgbdSequence::open(dir, options).load(0);
   EXPECT_FLOAT_EQ(frame.depth.at<float>(3, 3), 5.0f);
 }
 
@@ -116,7 +116,7 @@ TEST(RgbdSequence, DepthRegistrationShiftMovesTheDepthImage) {
   SequenceOptions options;
   options.warnings = nullptr;
   options.depth_shift_y = 1;
-  const RgbdFrame frame = RgbdSequence::open(sequence_dir, options).load(0);
+  const InputFrame frame = RgbdSequence::open(sequence_dir, options).load(0);
   EXPECT_FLOAT_EQ(frame.depth.at<float>(0, 1), 1.0f);  // row 1 of the image
   EXPECT_FLOAT_EQ(frame.depth.at<float>(5, 1), 0.0f);  // shifted in from below the border
 }
@@ -297,7 +297,7 @@ TEST(BonnCrowdDev, LoaderOnRealData) {
   EXPECT_EQ(sequence.files(0).depth_file, "depth/1548339819.88851.png");
   EXPECT_NEAR(sequence.timestamp(399) - sequence.timestamp(0), 13.374, 1e-3);
 
-  const RgbdFrame first = sequence.load(0);
+  const InputFrame first = sequence.load(0);
   EXPECT_EQ(first.bgr.type(), CV_8UC3);
   EXPECT_EQ(first.bgr.cols, 640);
   EXPECT_EQ(first.bgr.rows, 480);

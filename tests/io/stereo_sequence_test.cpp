@@ -66,7 +66,7 @@ TEST(KittiSequence, ReadsPairsTimesCalibrationAndPoses) {
   EXPECT_EQ(sequence.layout(), SequenceLayout::kitti);
   EXPECT_TRUE(sequence.stereo());
   EXPECT_DOUBLE_EQ(sequence.timestamp(2), 0.2);
-  const RgbdFrame frame = sequence.load(2);
+  const InputFrame frame = sequence.load(2);
   EXPECT_EQ(frame.bgr.type(), CV_8UC3);
   EXPECT_EQ(frame.right.type(), CV_8UC1);
   EXPECT_EQ(frame.gray.at<uint8_t>(0, 0), 20);
@@ -210,7 +210,7 @@ TEST(StereoTumSequence, ReadsLeftAndRightLists) {
   write_text(dir / "right.txt", right);
   const RgbdSequence sequence = RgbdSequence::open(dir, options);
   ASSERT_EQ(sequence.size(), 2u);
-  const RgbdFrame frame = sequence.load(1);
+  const InputFrame frame = sequence.load(1);
   EXPECT_EQ(frame.right.at<uint8_t>(0, 0), 8);
   EXPECT_TRUE(frame.depth.empty());
   cv::imwrite((dir / "right" / "1.png").string(), cv::Mat(3, 5, CV_8UC1, cv::Scalar(0)));

@@ -40,7 +40,7 @@ class LoopWorld {
  public:
   explicit LoopWorld(std::uint32_t seed, bool monocular = false)
       : rng_(seed), monocular_(monocular) {
-    camera_ = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(CameraConfig{}, 0.08));
+    camera_ = std::make_shared<const CameraModel>(CameraModel::from_config(CameraConfig{}, 0.08));
     pyramid_ = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
     std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
     std::uniform_real_distribution<double> height(-1.0, 1.0);
@@ -182,7 +182,7 @@ class LoopWorld {
   };
   std::mt19937 rng_;
   bool monocular_ = false;
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   std::vector<Landmark> landmarks_;
   std::map<int, LocalPoint> local_points_;

@@ -21,7 +21,7 @@ CameraConfig bonn_like_camera() {
 
 TEST(Frame, UndistortionAndBackProjectionRoundTrip) {
   const CameraConfig config = bonn_like_camera();
-  auto camera = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(config, 0.08));
+  auto camera = std::make_shared<const CameraModel>(CameraModel::from_config(config, 0.08));
   auto pyramid = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> xy(-0.5, 0.5);
@@ -72,7 +72,7 @@ TEST(Frame, UndistortionAndBackProjectionRoundTrip) {
 
 TEST(Frame, BackProjectionUsesThePose) {
   CameraConfig config;
-  auto camera = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(config, 0.08));
+  auto camera = std::make_shared<const CameraModel>(CameraModel::from_config(config, 0.08));
   auto pyramid = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.0f));
   std::vector<cv::KeyPoint> keypoints = {cv::KeyPoint(cv::Point2f(100.0f, 200.0f), 31.0f)};

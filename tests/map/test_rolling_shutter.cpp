@@ -90,7 +90,7 @@ TEST(RollingShutter, FrameReadsDepthWhereTheCorrectedKeypointLies) {
   CameraConfig config;
   config.pinhole = camera.pinhole;
   config.rolling_shutter_readout_s = camera.readout;
-  auto rgbd = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(config, 0.08));
+  auto rgbd = std::make_shared<const CameraModel>(CameraModel::from_config(config, 0.08));
   auto pyramid = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   cv::Mat depth_image(camera.pinhole.height, camera.pinhole.width, CV_32F, cv::Scalar(0));
   std::vector<cv::KeyPoint> keypoints;
@@ -135,7 +135,7 @@ TEST(RollingShutter, StereoFrameTurnsTheTriangulatedPoint) {
   config.baseline = 0.1;
   config.pinhole = camera.pinhole;
   config.rolling_shutter_readout_s = camera.readout;
-  auto rgbd = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(config, 0.08));
+  auto rgbd = std::make_shared<const CameraModel>(CameraModel::from_config(config, 0.08));
   auto pyramid = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   std::vector<cv::KeyPoint> keypoints;
   std::vector<float> depths, right_us;

@@ -8,7 +8,7 @@ namespace pspslam::testing {
 
 SyntheticWorld::SyntheticWorld(int num_points, double no_depth_fraction, uint32_t seed)
     : rng_(seed) {
-  camera_ = std::make_shared<const RgbdCamera>(RgbdCamera::from_config(CameraConfig{}, 0.08));
+  camera_ = std::make_shared<const CameraModel>(CameraModel::from_config(CameraConfig{}, 0.08));
   pyramid_ = std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   std::uniform_real_distribution<double> x(-2.5, 3.5), y(-1.5, 1.5), z(1.5, 5.0);
   std::bernoulli_distribution no_depth(no_depth_fraction);

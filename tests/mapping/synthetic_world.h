@@ -9,10 +9,10 @@
 #include <random>
 #include <vector>
 
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 
 namespace pspslam::testing {
@@ -29,7 +29,7 @@ class SyntheticWorld {
   // num_points points in a box 1.5–5 m in front of the start, a fraction without depth.
   SyntheticWorld(int num_points, double no_depth_fraction, uint32_t seed);
 
-  const std::shared_ptr<const RgbdCamera>& camera() const { return camera_; }
+  const std::shared_ptr<const CameraModel>& camera() const { return camera_; }
   const std::shared_ptr<const ScalePyramid>& pyramid() const { return pyramid_; }
   const std::vector<WorldPoint>& points() const { return points_; }
 
@@ -51,7 +51,7 @@ class SyntheticWorld {
   int world_index(const MapPoint& point) const;
 
  private:
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   std::vector<WorldPoint> points_;
   std::map<std::uint64_t, std::vector<int>> keypoint_world_index_;

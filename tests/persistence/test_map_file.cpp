@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "pspslam/core/error.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/persistence/map_file.h"
 #include "pspslam/synth/scene.h"
@@ -94,11 +94,11 @@ class MapFileTest : public ::testing::Test {
   // Loads into a fresh map with the synthetic camera; returns the error message ("" if none).
   static std::string load_error(const std::filesystem::path& file, double fx_change = 0.0) {
     const SystemConfig config = synthetic_system_config();
-    RgbdCamera camera = RgbdCamera::from_config(config.camera, 0.08);
+    CameraModel camera = CameraModel::from_config(config.camera, 0.08);
     camera.pinhole.fx += fx_change;
     Map map;
     try {
-      load_map(file, map, std::make_shared<const RgbdCamera>(camera),
+      load_map(file, map, std::make_shared<const CameraModel>(camera),
                std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb)));
     } catch (const Error& e) {
       EXPECT_EQ(map.num_keyframes(), 0u) << "a failed load must leave the map untouched";
@@ -129,7 +129,7 @@ TEST_F(MapFileTest, LoadRebuildsTheSameKeyframesPointsAndGraph) {
   Map map;
   const MapFileSummary summary =
       load_map(map_file(), map,
-               std::make_shared<const RgbdCamera>(RgbdCamera::from_config(config.camera, 0.08)),
+               std::make_shared<const CameraModel>(CameraModel::from_config(config.camera, 0.08)),
                std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb)));
   EXPECT_EQ(summary.keyframes, keyframes_saved_);
   EXPECT_EQ(summary.map_points, points_saved_);

@@ -366,7 +366,7 @@ TEST(SynthKinect, DepthListCarriesTheDepthCaptureInstant) {
   const RgbdSequence sequence = RgbdSequence::open(dir);
   ASSERT_EQ(sequence.size(), 6u);
   for (size_t i = 0; i < 6; ++i) {
-    const RgbdFrame frame = sequence.load(i);
+    const InputFrame frame = sequence.load(i);
     EXPECT_NEAR(frame.depth_timestamp - frame.timestamp, scene.depth_time_offset(i), 1.5e-6);
   }
 }

@@ -34,7 +34,7 @@ double online_ate(const SyntheticScene& scene, const SystemConfig& config) {
   SynthFrame rendered;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
     scene.render(i, rendered, 1);
-    RgbdFrame frame;
+    InputFrame frame;
     frame.index = i;
     frame.timestamp = scene.timestamp(i);
     frame.bgr = rendered.bgr;

@@ -32,9 +32,9 @@ SynthOptions stereo_room(size_t frames, int bodies) {
 
 // Frame i as the stereo camera delivers it (colour left, grey right); `rendered` keeps the
 // rendering, ground-truth labels included.
-RgbdFrame stereo_frame(const SyntheticScene& scene, size_t i, SynthFrame& rendered) {
+InputFrame stereo_frame(const SyntheticScene& scene, size_t i, SynthFrame& rendered) {
   scene.render(i, rendered, 1);
-  RgbdFrame frame;
+  InputFrame frame;
   frame.index = i;
   frame.timestamp = scene.timestamp(i);
   frame.bgr = rendered.bgr;
@@ -108,7 +108,7 @@ TEST(Stereo, GeometryMaskStaysOnThePeople) {
 // fifth (those start inline), and one more frame announced at the end that is never processed.
 TEST(Stereo, FramesPreparedAheadGiveTheSameTrajectory) {
   const SyntheticScene scene(stereo_room(41, 2));  // the 41st is announced, never processed
-  std::vector<RgbdFrame> frames;
+  std::vector<InputFrame> frames;
   SynthFrame rendered;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
     frames.push_back(stereo_frame(scene, i, rendered));
@@ -141,7 +141,7 @@ TEST(Stereo, FramesPreparedAheadGiveTheSameTrajectory) {
 TEST(Stereo, AFrameWithoutItsRightImageIsAnErrorNamingIt) {
   const SyntheticScene scene(stereo_room(1, 0));
   System system(scene.system_config());
-  RgbdFrame frame;
+  InputFrame frame;
   frame.bgr = scene.render(0).bgr;
   frame.name = "rgb/1.png";
   try {

@@ -82,7 +82,7 @@ TEST(System, KeypointFatesAreOptInAndAccountForEveryKeypoint) {
     SynthFrame rendered;
     for (size_t i = 0; i < scene.frame_count(); ++i) {
       scene.render(i, rendered, 1);
-      RgbdFrame frame;
+      InputFrame frame;
       frame.index = i;
       frame.timestamp = scene.timestamp(i);
       frame.bgr = rendered.bgr;

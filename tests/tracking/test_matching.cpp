@@ -96,8 +96,8 @@ class ProjectionSearchTest : public ::testing::Test {
   }
 
   static constexpr int kPoints = 300;
-  std::shared_ptr<const RgbdCamera> camera_ =
-      std::make_shared<const RgbdCamera>(RgbdCamera::from_config(CameraConfig{}, 0.08));
+  std::shared_ptr<const CameraModel> camera_ =
+      std::make_shared<const CameraModel>(CameraModel::from_config(CameraConfig{}, 0.08));
   std::shared_ptr<const ScalePyramid> pyramid_ =
       std::make_shared<const ScalePyramid>(ScalePyramid::from_config(OrbConfig{}));
   Map map_;

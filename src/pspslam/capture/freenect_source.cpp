@@ -114,7 +114,7 @@ class FreenectSource final : public FrameSource {
     }
   }
 
-  std::optional<RgbdFrame> next() override {
+  std::optional<InputFrame> next() override {
     const double limit =
         delivered_ == 0 ? options_.first_frame_timeout_s : options_.silence_timeout_s;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
@@ -205,8 +205,8 @@ class FreenectSource final : public FrameSource {
     }
   }
 
-  RgbdFrame convert(RawFrame raw) {
-    RgbdFrame frame;
+  InputFrame convert(RawFrame raw) {
+    InputFrame frame;
     frame.index = raw.index;
     frame.timestamp = raw.colour_time;
     frame.depth_timestamp = raw.depth_time;

@@ -51,7 +51,7 @@ SequenceRecorder::SequenceRecorder(const std::filesystem::path& dir,
   depth_list_ = open_list(dir / "depth.txt", "depth maps");
 }
 
-void SequenceRecorder::add(const RgbdFrame& frame) {
+void SequenceRecorder::add(const InputFrame& frame) {
   const std::string rgb_file = "rgb/" + stamp(frame.timestamp) + ".png";
   const std::string depth_file = "depth/" + stamp(frame.depth_timestamp) + ".png";
   cv::Mat depth;

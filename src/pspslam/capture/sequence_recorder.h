@@ -22,7 +22,7 @@ class SequenceRecorder {
   SequenceRecorder(const std::filesystem::path& dir, const std::filesystem::path& config_file,
                    double depth_factor);
 
-  void add(const RgbdFrame& frame);
+  void add(const InputFrame& frame);
   size_t frames() const { return frames_; }
 
  private:

@@ -81,7 +81,7 @@ DynamicPipeline::DynamicPipeline(const DynamicOptions& options, const PinholeCam
 // Out of line: SemanticThread is incomplete in the header.
 DynamicPipeline::~DynamicPipeline() = default;
 
-void DynamicPipeline::announce(const RgbdFrame& frame) {
+void DynamicPipeline::announce(const InputFrame& frame) {
   if (!semantic_) return;
   const std::int64_t id = next_announced_++;
   // With a stride the frames in between use the newest mask, warped (semantic_mask()). A live
@@ -98,7 +98,7 @@ void DynamicPipeline::announce(const RgbdFrame& frame) {
   semantic_->submit(id, frame.timestamp, frame.bgr);
 }
 
-cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray,
+cv::Mat DynamicPipeline::begin_frame(const InputFrame& frame, const cv::Mat& gray,
                                      DynamicReport& report) {
   current_id_ = next_id_++;
   labels_.release();
@@ -125,7 +125,7 @@ cv::Mat DynamicPipeline::begin_frame(const RgbdFrame& frame, const cv::Mat& gray
   return {};
 }
 
-cv::Mat DynamicPipeline::mask_from_file(const RgbdFrame& frame, DynamicReport& report) const {
+cv::Mat DynamicPipeline::mask_from_file(const InputFrame& frame, DynamicReport& report) const {
   const std::filesystem::path file = options_.semantic_masks / per_frame_png_name(frame.name);
   // Checked first: OpenCV would also print a warning of its own for a missing file.
   const cv::Mat image = std::filesystem::is_regular_file(file)

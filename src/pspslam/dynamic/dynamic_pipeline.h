@@ -29,7 +29,7 @@ class KeyFrame;
 class Map;
 class SemanticThread;
 struct SemanticResult;
-struct RgbdFrame;
+struct InputFrame;
 
 // How a live run brings an older mask into the current frame.
 enum class StaleMaskPolicy : std::uint8_t {
@@ -148,12 +148,12 @@ class DynamicPipeline {
   DynamicPipeline& operator=(const DynamicPipeline&) = delete;
 
   // Hands a frame to the semantic thread ahead of begin_frame (see System::announce).
-  void announce(const RgbdFrame& frame);
+  void announce(const InputFrame& frame);
 
   // Steps 1-2: homography to the previous frame, then the semantic mask of this frame (empty
   // when none is usable). With DynamicOptions::semantic_masks, the mask is read from there;
   // throws pspslam::Error naming the file when it is missing or not the frame's size.
-  cv::Mat begin_frame(const RgbdFrame& frame, const cv::Mat& gray, DynamicReport& report);
+  cv::Mat begin_frame(const InputFrame& frame, const cv::Mat& gray, DynamicReport& report);
 
   // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
   // `keypoint_depths`: each keypoint's own depth measurement (FrameBuilder::keypoint_depths;
@@ -197,7 +197,7 @@ class DynamicPipeline {
     std::chrono::steady_clock::time_point time;
   };
 
-  cv::Mat mask_from_file(const RgbdFrame& frame, DynamicReport& report) const;
+  cv::Mat mask_from_file(const InputFrame& frame, DynamicReport& report) const;
   cv::Mat semantic_mask(DynamicReport& report);
   // A live run's older mask moved into the current frame (StaleMaskPolicy::flow).
   cv::Mat propagate_mask(const SemanticResult& result, DynamicReport& report);

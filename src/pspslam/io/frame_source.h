@@ -26,9 +26,9 @@ class FrameSource {
  public:
   virtual ~FrameSource() = default;
 
-  // The next frame (RgbdFrame::index counts delivered frames from 0), or nullopt at the end of
+  // The next frame (InputFrame::index counts delivered frames from 0), or nullopt at the end of
   // the stream. A live source blocks until its device delivers. Errors throw pspslam::Error.
-  virtual std::optional<RgbdFrame> next() = 0;
+  virtual std::optional<InputFrame> next() = 0;
 
   // How many frames the stream holds when that is known in advance (a recorded sequence).
   virtual std::optional<size_t> frame_count() const { return std::nullopt; }

@@ -453,9 +453,9 @@ std::optional<std::filesystem::path> RgbdSequence::config_path() const {
   return std::nullopt;
 }
 
-RgbdFrame RgbdSequence::load(size_t i) const {
+InputFrame RgbdSequence::load(size_t i) const {
   const FrameFiles& files = frames_.at(i);
-  RgbdFrame frame;
+  InputFrame frame;
   frame.index = i;
   frame.timestamp = files.rgb_timestamp;
   frame.depth_timestamp = files.depth_timestamp;

@@ -28,10 +28,10 @@ struct SequenceOptions {
   // Where open() prints its one-line missing-files warning; nullptr keeps it silent (the text
   // stays available through RgbdSequence::warning()).
   std::ostream* warnings = &std::cerr;
-  // RgbdFrame::gray is filled only when asked (saves a colour conversion per frame).
+  // InputFrame::gray is filled only when asked (saves a colour conversion per frame).
   bool load_gray = true;
   // A rectified stereo pair per frame instead of colour + depth: the TUM-style lists are
-  // rgb.txt (left) and right.txt (right, CV_8UC1 in RgbdFrame::right); no depth is read.
+  // rgb.txt (left) and right.txt (right, CV_8UC1 in InputFrame::right); no depth is read.
   bool stereo = false;
   // Colour images only (a monocular run on an RGB-D folder): rgb.txt alone is read, every listed
   // colour image is a frame, and no depth is listed, associated or loaded.
@@ -46,8 +46,9 @@ enum class SequenceLayout {
 };
 std::string to_string(SequenceLayout layout);
 
-// One associated colour/depth frame in memory.
-struct RgbdFrame {
+// The images of one moment as the sensor delivered them, whatever the sensor: colour with depth
+// (RGB-D), colour with the rectified right image (stereo) or colour alone (monocular).
+struct InputFrame {
   size_t index = 0;           // position in the sequence (0 .. size()-1)
   Timestamp timestamp = 0.0;  // colour timestamp
   Timestamp depth_timestamp = 0.0;
@@ -122,7 +123,7 @@ class RgbdSequence {
 
   // Decodes frame i. Errors name the file: unreadable/empty image, depth not 16-bit
   // single-channel, colour and depth of different size.
-  RgbdFrame load(size_t i) const;
+  InputFrame load(size_t i) const;
 
   const std::filesystem::path& directory() const { return dir_; }
   const SequenceOptions& options() const { return options_; }
@@ -178,7 +179,7 @@ cv::Mat depth_to_metres(const cv::Mat& raw, double depth_factor, int shift_x = 0
 // Reads a colour image (PNG, JPEG, ...) as CV_8UC3 BGR.
 cv::Mat read_color_image(const std::filesystem::path& file);
 
-// The file name of a per-frame picture of the colour image `rgb_file` (RgbdFrame::name):
+// The file name of a per-frame picture of the colour image `rgb_file` (InputFrame::name):
 // "rgb/1548339828.32144.jpg" -> "1548339828.32144.png". What `--save-masks` and
 // `--save-overlays` write and `--semantic-masks` reads.
 std::filesystem::path per_frame_png_name(const std::filesystem::path& rgb_file);

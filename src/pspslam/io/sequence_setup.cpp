@@ -54,7 +54,7 @@ SequenceSetup open_kitti_with_config(const std::filesystem::path& dir,
   SequenceOptions options;
   options.warnings = warnings;
   RgbdSequence sequence = RgbdSequence::open_kitti(dir, options);
-  const RgbdFrame first = sequence.load(0);
+  const InputFrame first = sequence.load(0);
   CameraConfig& camera = config.camera;
   if (!config_file) camera.name = "kitti";
   set_rectified_stereo_camera(camera, first.bgr.size(), calibration.fx, calibration.fy,

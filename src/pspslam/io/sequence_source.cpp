@@ -12,7 +12,7 @@ namespace pspslam {
 
 namespace {
 
-size_t frame_bytes(const RgbdFrame& frame) {
+size_t frame_bytes(const InputFrame& frame) {
   size_t bytes = 0;
   for (const cv::Mat* image : {&frame.bgr, &frame.depth, &frame.right})
     bytes += image->total() * image->elemSize();
@@ -29,7 +29,7 @@ SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool pace
   if (preload == Preload::on && !paced_)
     throw Error("--preload: only a --realtime run replays at the camera's rate");
   if (paced_ && preload != Preload::off && frames_ > 0) {
-    RgbdFrame first = setup_.sequence.load(0);
+    InputFrame first = setup_.sequence.load(0);
     const double need = static_cast<double>(frame_bytes(first)) * static_cast<double>(frames_);
     const size_t limit = preload == Preload::on ? kPreloadLimitBytes : kAutoPreloadBytes;
     if (need <= static_cast<double>(limit)) {
@@ -82,7 +82,7 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
       index = newest;
       // Decoded ahead, delivered when due; one that is late when decoded is delivered at once,
       // and that lateness counts in its latency (its arrival stays the due time).
-      RgbdFrame frame = preloaded_.empty() ? sequence.load(index) : std::move(preloaded_[index]);
+      InputFrame frame = preloaded_.empty() ? sequence.load(index) : std::move(preloaded_[index]);
       const auto due = due_time(index);
       {
         std::unique_lock lock(start_mutex_);
@@ -101,7 +101,7 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
   delivered_.close("end of sequence");
 }
 
-std::optional<RgbdFrame> SequenceSource::next() {
+std::optional<InputFrame> SequenceSource::next() {
   if (!paced_) {
     if (next_index_ >= frames_) return std::nullopt;
     return setup_.sequence.load(next_index_++);
@@ -112,7 +112,7 @@ std::optional<RgbdFrame> SequenceSource::next() {
   }
   start_cv_.notify_all();
   for (;;) {
-    if (std::optional<RgbdFrame> frame = delivered_.pop(std::chrono::milliseconds(1000)))
+    if (std::optional<InputFrame> frame = delivered_.pop(std::chrono::milliseconds(1000)))
       return frame;
     if (delivered_.closed()) {
       std::lock_guard lock(start_mutex_);

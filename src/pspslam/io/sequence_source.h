@@ -45,7 +45,7 @@ class SequenceSource final : public FrameSource {
   SequenceSource(const SequenceSource&) = delete;
   SequenceSource& operator=(const SequenceSource&) = delete;
 
-  std::optional<RgbdFrame> next() override;
+  std::optional<InputFrame> next() override;
   std::optional<size_t> frame_count() const override { return frames_; }
   std::string name() const override { return setup_.sequence.directory().string(); }
   std::string describe() const override;
@@ -67,10 +67,10 @@ class SequenceSource final : public FrameSource {
   SequenceSetup setup_;
   size_t frames_ = 0;
   bool paced_ = false;
-  size_t next_index_ = 0;             // deterministic reading
-  std::vector<RgbdFrame> preloaded_;  // --preload: every frame, decoded before the run
+  size_t next_index_ = 0;              // deterministic reading
+  std::vector<InputFrame> preloaded_;  // --preload: every frame, decoded before the run
   size_t preloaded_bytes_ = 0;
-  LatestQueue<RgbdFrame> delivered_{1};
+  LatestQueue<InputFrame> delivered_{1};
   std::atomic<size_t> skipped_{0};  // frames the reader never decoded: it was late for them
   std::mutex start_mutex_;
   std::condition_variable_any start_cv_;

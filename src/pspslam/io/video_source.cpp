@@ -39,10 +39,10 @@ class VideoSource final : public FrameSource {
       frame_count_ = static_cast<size_t>(frames);
   }
 
-  std::optional<RgbdFrame> next() override {
+  std::optional<InputFrame> next() override {
     cv::Mat image;
     if (!capture_.read(image) || image.empty()) return std::nullopt;
-    RgbdFrame frame;
+    InputFrame frame;
     frame.index = delivered_++;
     if (image.channels() == 1) {
       cv::cvtColor(image, frame.bgr, cv::COLOR_GRAY2BGR);

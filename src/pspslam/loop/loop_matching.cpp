@@ -24,7 +24,7 @@ bool predict(const KeyFrame& keyframe, const Pose& T_camera_world, const Eigen::
              const MapPoint& point, const Eigen::Vector3d& position, Prediction& out) {
   const Eigen::Vector3d point_camera = T_camera_world * position;
   if (point_camera.z() <= 0.0) return false;
-  const RgbdCamera& camera = keyframe.camera();
+  const CameraModel& camera = keyframe.camera();
   const Eigen::Vector2d pixel = camera.pinhole.project(point_camera);
   if (!camera.in_bounds(pixel.x(), pixel.y())) return false;
   const Eigen::Vector3d ray = position - center;

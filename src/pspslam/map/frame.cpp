@@ -10,7 +10,7 @@ namespace pspslam {
 
 Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
              cv::Mat descriptors, const cv::Mat& depth_metres,
-             std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid,
+             std::shared_ptr<const CameraModel> camera, std::shared_ptr<const ScalePyramid> pyramid,
              const Eigen::Vector3d& angular_velocity)
     : id_(id),
       timestamp_(timestamp),
@@ -63,7 +63,7 @@ Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> ke
 
 Frame::Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
              cv::Mat descriptors, std::vector<float> depth, std::vector<float> right_u,
-             std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid,
+             std::shared_ptr<const CameraModel> camera, std::shared_ptr<const ScalePyramid> pyramid,
              const Eigen::Vector3d& angular_velocity)
     : id_(id),
       timestamp_(timestamp),

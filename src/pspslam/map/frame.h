@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "pspslam/core/types.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/feature_grid.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/place/bow_vector.h"
 
@@ -25,11 +25,11 @@ class Frame {
   // `keypoints` are in distorted image coordinates as the extractor returns them; depth is
   // read there (the depth image is registered to the distorted colour image), then the
   // keypoints are undistorted once and, for a rolling-shutter camera
-  // (RgbdCamera::rolling_shutter_readout_s), moved to the frame's instant with
+  // (CameraModel::rolling_shutter_readout_s), moved to the frame's instant with
   // `angular_velocity` (rad/s, camera frame; camera/rolling_shutter.h). `descriptors`: N x 32
   // CV_8U (shared, not copied).
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
-        cv::Mat descriptors, const cv::Mat& depth_metres, std::shared_ptr<const RgbdCamera> camera,
+        cv::Mat descriptors, const cv::Mat& depth_metres, std::shared_ptr<const CameraModel> camera,
         std::shared_ptr<const ScalePyramid> pyramid,
         const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
   // A frame whose depth was measured per keypoint (a rectified stereo pair: depth and right
@@ -38,7 +38,7 @@ class Frame {
   // read their rows together, so a rolling-shutter correction turns the triangulated point.
   Frame(std::uint64_t id, Timestamp timestamp, std::vector<cv::KeyPoint> keypoints,
         cv::Mat descriptors, std::vector<float> depth, std::vector<float> right_u,
-        std::shared_ptr<const RgbdCamera> camera, std::shared_ptr<const ScalePyramid> pyramid,
+        std::shared_ptr<const CameraModel> camera, std::shared_ptr<const ScalePyramid> pyramid,
         const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
 
   std::uint64_t id() const { return id_; }
@@ -56,9 +56,9 @@ class Frame {
   bool has_depth(int i) const { return depth_[i] > 0.0f; }
   const std::vector<float>& depths() const { return depth_; }
   const std::vector<float>& right_us() const { return right_u_; }
-  const RgbdCamera& camera() const { return *camera_; }
+  const CameraModel& camera() const { return *camera_; }
   const ScalePyramid& pyramid() const { return *pyramid_; }
-  const std::shared_ptr<const RgbdCamera>& camera_ptr() const { return camera_; }
+  const std::shared_ptr<const CameraModel>& camera_ptr() const { return camera_; }
   const std::shared_ptr<const ScalePyramid>& pyramid_ptr() const { return pyramid_; }
   const FeatureGrid& grid() const { return grid_; }
 
@@ -104,7 +104,7 @@ class Frame {
   cv::Mat descriptors_;
   std::vector<float> depth_;
   std::vector<float> right_u_;
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   FeatureGrid grid_;
   std::optional<Pose> T_camera_world_;

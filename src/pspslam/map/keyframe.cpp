@@ -19,7 +19,7 @@ constexpr int kMinCovisibilityWeight = 15;
 std::vector<float> right_coordinates(std::uint64_t frame_id,
                                      const std::vector<cv::KeyPoint>& keypoints,
                                      const cv::Mat& descriptors, const std::vector<float>& depth,
-                                     const RgbdCamera& camera) {
+                                     const CameraModel& camera) {
   if (depth.size() != keypoints.size() || descriptors.rows != static_cast<int>(keypoints.size())) {
     throw Error("keyframe of frame " + std::to_string(frame_id) + ": " +
                 std::to_string(keypoints.size()) + " keypoints but " +
@@ -61,7 +61,7 @@ void KeyFrame::compute_bow(const Vocabulary& vocabulary, int direct_index_level)
   bow_ready_.store(true, std::memory_order_release);
 }
 
-KeyFrame::KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const RgbdCamera> camera,
+KeyFrame::KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const CameraModel> camera,
                    std::shared_ptr<const ScalePyramid> pyramid)
     : id_(id),
       frame_id_(data.frame_id),

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "pspslam/core/types.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/feature_grid.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/place/bow_vector.h"
 
@@ -43,7 +43,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   KeyFrame(std::uint64_t id, const Frame& frame);
   // Rebuilds a keyframe (map loading): right_u and the feature grid are derived again.
   // Throws pspslam::Error when the per-keypoint arrays disagree in length.
-  KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const RgbdCamera> camera,
+  KeyFrame(std::uint64_t id, KeyFrameData data, std::shared_ptr<const CameraModel> camera,
            std::shared_ptr<const ScalePyramid> pyramid);
 
   std::uint64_t id() const { return id_; }
@@ -64,7 +64,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   float depth(int i) const { return depth_[i]; }
   float right_u(int i) const { return right_u_[i]; }  // NaN without depth (see Frame)
   bool has_depth(int i) const { return depth_[i] > 0.0f; }
-  const RgbdCamera& camera() const { return *camera_; }
+  const CameraModel& camera() const { return *camera_; }
   const ScalePyramid& pyramid() const { return *pyramid_; }
   void features_in_area(double x, double y, double radius, int min_level, int max_level,
                         std::vector<int>& out) const {
@@ -140,7 +140,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const cv::Mat descriptors_;
   const std::vector<float> depth_;
   const std::vector<float> right_u_;
-  const std::shared_ptr<const RgbdCamera> camera_;
+  const std::shared_ptr<const CameraModel> camera_;
   const std::shared_ptr<const ScalePyramid> pyramid_;
   const FeatureGrid grid_;
 

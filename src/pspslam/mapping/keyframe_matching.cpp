@@ -30,7 +30,7 @@ Eigen::Matrix3d fundamental_matrix(const KeyFrame& first, const KeyFrame& second
 // level's information.
 double keypoint_chi_squared(const KeyFrame& keyframe, int index,
                             const Eigen::Vector3d& point_camera) {
-  const RgbdCamera& camera = keyframe.camera();
+  const CameraModel& camera = keyframe.camera();
   const cv::KeyPoint& keypoint = keyframe.keypoints()[index];
   const Eigen::Vector2d projected = camera.pinhole.project(point_camera);
   const double du = keypoint.pt.x - projected.x();
@@ -106,7 +106,7 @@ int fuse_into_keyframe(Map& map, const std::shared_ptr<KeyFrame>& keyframe,
                        int max_descriptor_distance) {
   const Pose T_cw = keyframe->T_camera_world();
   const Eigen::Vector3d center = keyframe->camera_center();
-  const RgbdCamera& camera = keyframe->camera();
+  const CameraModel& camera = keyframe->camera();
   const ScalePyramid& pyramid = keyframe->pyramid();
   std::vector<int> candidates;
   int fused = 0;

@@ -83,7 +83,7 @@ LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
   report.observations = static_cast<int>(window.problem.observations.size());
   if (window.problem.observations.empty()) return report;
 
-  const RgbdCamera& camera = keyframe->camera();
+  const CameraModel& camera = keyframe->camera();
   report.result = solve_bundle_adjustment(window.problem, camera.pinhole, camera.bf, options);
 
   std::lock_guard lock(map.update_mutex());

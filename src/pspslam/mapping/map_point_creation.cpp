@@ -44,7 +44,7 @@ bool reprojects(const KeyFrame& keyframe, int index, const Pose& T_camera_world,
                 const Eigen::Vector3d& position) {
   const Eigen::Vector3d point_camera = T_camera_world * position;
   if (point_camera.z() <= 0.0) return false;
-  const RgbdCamera& camera = keyframe.camera();
+  const CameraModel& camera = keyframe.camera();
   const cv::KeyPoint& keypoint = keyframe.keypoints()[index];
   const Eigen::Vector2d pixel = camera.pinhole.project(point_camera);
   const double du = keypoint.pt.x - pixel.x();

@@ -33,7 +33,7 @@ bool project_map_point(const std::shared_ptr<MapPoint>& point, const Frame& fram
   const Pose& T_cw = frame.T_camera_world();
   const Eigen::Vector3d p_camera = T_cw * position;
   if (p_camera.z() <= 0.0) return false;
-  const RgbdCamera& camera = frame.camera();
+  const CameraModel& camera = frame.camera();
   const Eigen::Vector2d pixel = camera.pinhole.project(p_camera);
   if (!camera.in_bounds(pixel.x(), pixel.y())) return false;
   const Eigen::Vector3d ray = position - T_cw.inverse().translation();
@@ -141,7 +141,7 @@ int search_previous_frame(Frame& current, const Frame& previous, double radius,
                           const MatcherOptions& options) {
   const Pose& T_cw = current.T_camera_world();
   const ScalePyramid& pyramid = current.pyramid();
-  const RgbdCamera& camera = current.camera();
+  const CameraModel& camera = current.camera();
   // Camera moving forward / backward along its axis shifts the expected scale of features.
   const Eigen::Vector3d t_last_current =
       previous.T_camera_world() * current.T_camera_world().inverse().translation();

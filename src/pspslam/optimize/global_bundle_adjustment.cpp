@@ -55,7 +55,7 @@ GlobalBaResult solve_global_bundle_adjustment(const Map& map, const GlobalBaOpti
   ba.max_seconds = options.max_seconds;
   ba.depth_noise = options.depth_noise;
   ba.should_stop = options.should_stop;
-  const RgbdCamera& camera = any_keyframe->camera();
+  const CameraModel& camera = any_keyframe->camera();
   const BaResult solved = solve_bundle_adjustment(problem, camera.pinhole, camera.bf, ba);
   result.iterations = solved.iterations;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -17,10 +17,10 @@
 
 #include "pspslam/core/checksum.h"
 #include "pspslam/core/error.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 
 // File format, version 1 (little-endian, no padding):
@@ -158,7 +158,7 @@ struct KeyFrameRecord {
 
 }  // namespace
 
-MapFileSummary save_map(Map& map, const RgbdCamera& camera, const ScalePyramid& pyramid,
+MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid& pyramid,
                         const std::filesystem::path& file) {
   std::lock_guard lock(map.update_mutex());
   const auto keyframes = map.keyframes();
@@ -246,7 +246,7 @@ MapFileSummary save_map(Map& map, const RgbdCamera& camera, const ScalePyramid& 
 }
 
 MapFileSummary load_map(const std::filesystem::path& file, Map& map,
-                        std::shared_ptr<const RgbdCamera> camera,
+                        std::shared_ptr<const CameraModel> camera,
                         std::shared_ptr<const ScalePyramid> pyramid) {
   const std::string prefix = "map file '" + file.string() + "': ";
   std::ifstream stream(file, std::ios::binary);

@@ -7,7 +7,7 @@
 namespace pspslam {
 
 class Map;
-struct RgbdCamera;
+struct CameraModel;
 struct ScalePyramid;
 
 struct MapFileSummary {
@@ -26,7 +26,7 @@ struct MapFileSummary {
 //
 // Saving needs a quiet map: call it after System::shutdown() (it takes Map::update_mutex()).
 // Throws pspslam::Error naming the file when it cannot be written.
-MapFileSummary save_map(Map& map, const RgbdCamera& camera, const ScalePyramid& pyramid,
+MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid& pyramid,
                         const std::filesystem::path& file);
 
 // Loads a map file into `map`, which must be empty. Keyframe and map point ids are renumbered
@@ -36,7 +36,7 @@ MapFileSummary save_map(Map& map, const RgbdCamera& camera, const ScalePyramid& 
 // version, truncated, checksum mismatch, different camera, inconsistent content. On error the
 // map is left untouched (the whole file is checked before anything is created).
 MapFileSummary load_map(const std::filesystem::path& file, Map& map,
-                        std::shared_ptr<const RgbdCamera> camera,
+                        std::shared_ptr<const CameraModel> camera,
                         std::shared_ptr<const ScalePyramid> pyramid);
 
 }  // namespace pspslam

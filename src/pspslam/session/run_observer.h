@@ -8,12 +8,12 @@
 
 namespace pspslam {
 
-struct RgbdFrame;
+struct InputFrame;
 
 // One processed frame as a watcher of the run sees it, on the run loop's thread; everything is
 // valid only during RunObserver::frame_done().
 struct FrameView {
-  const RgbdFrame& frame;
+  const InputFrame& frame;
   const FrameReport& report;
   const System& system;
   const RunStatistics& statistics;

@@ -89,7 +89,7 @@ class RunStatistics {
   // sleeps, which costs no CPU): what watching costs the frames, apart from the detail recorded
   // inside System::process for the shown frames.
   std::vector<double> observer_cpu_ms;
-  // Frames with an arrival time (RgbdFrame::arrival: --realtime, cameras): from arrival to the
+  // Frames with an arrival time (InputFrame::arrival: --realtime, cameras): from arrival to the
   // end of System::process(), i.e. until the pose (or the verdict that there is none) exists.
   std::vector<double> arrival_to_pose_ms;
   size_t tested_points = 0;

@@ -114,9 +114,9 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
 
 SequenceRunner::~SequenceRunner() = default;
 
-std::optional<RgbdFrame> SequenceRunner::next_frame() {
+std::optional<InputFrame> SequenceRunner::next_frame() {
   if (frames_ > 0 && delivered_ >= frames_) return std::nullopt;
-  std::optional<RgbdFrame> loaded = input_.source->next();
+  std::optional<InputFrame> loaded = input_.source->next();
   if (!loaded) return std::nullopt;
   ++delivered_;
   const size_t before = statistics_.realtime_dropped();
@@ -132,7 +132,7 @@ std::optional<RgbdFrame> SequenceRunner::next_frame() {
   return loaded;
 }
 
-void SequenceRunner::check_frame_size(const RgbdFrame& frame) const {
+void SequenceRunner::check_frame_size(const InputFrame& frame) const {
   const PinholeCamera& camera = input_.config.camera.pinhole;
   if (frame.bgr.cols != camera.width || frame.bgr.rows != camera.height) {
     throw Error((std::filesystem::path(input_.source->name()) / frame.name).string() + " is " +
@@ -151,15 +151,15 @@ RunOutcome SequenceRunner::run() {
   const auto start = std::chrono::steady_clock::now();
   // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
   // network segments frame i+1 while frame i is tracked.
-  std::optional<RgbdFrame> next;
+  std::optional<InputFrame> next;
   // Frames before the first map: a sequence that never starts (no depth readings) is told why,
   // after a second of video and again at the end, instead of ending with 0 poses.
   StartWatch start_watch(static_cast<size_t>(std::max(1.0, input_.config.camera.fps)));
   for (bool first = true; !interrupted(); first = false) {
-    std::optional<RgbdFrame> current = next ? std::move(next) : next_frame();
+    std::optional<InputFrame> current = next ? std::move(next) : next_frame();
     next.reset();
     if (!current) break;
-    const RgbdFrame& frame = *current;
+    const InputFrame& frame = *current;
     if (!realtime) {
       next = next_frame();
       if (first) system_->announce(frame);
@@ -252,7 +252,7 @@ RunOutcome SequenceRunner::run() {
   return RunOutcome::completed;
 }
 
-void SequenceRunner::write_images(const RgbdFrame& frame, const FrameReport& report) {
+void SequenceRunner::write_images(const InputFrame& frame, const FrameReport& report) {
   if (!images_.writes_masks() && !images_.writes_overlays()) return;
   const std::filesystem::path rgb_file = frame.name;
   if (images_.writes_masks())

@@ -20,7 +20,7 @@
 
 namespace pspslam {
 
-struct RgbdFrame;
+struct InputFrame;
 
 // What a run reads: its frames and the camera config they are processed with.
 struct RunInput {
@@ -58,9 +58,9 @@ class SequenceRunner {
   RunOutcome run();
 
  private:
-  std::optional<RgbdFrame> next_frame();
-  void check_frame_size(const RgbdFrame& frame) const;
-  void write_images(const RgbdFrame& frame, const FrameReport& report);
+  std::optional<InputFrame> next_frame();
+  void check_frame_size(const InputFrame& frame) const;
+  void write_images(const InputFrame& frame, const FrameReport& report);
   void finish(double seconds);
 
   RunOptions options_;

@@ -17,20 +17,20 @@ bool same_keypoint(const cv::KeyPoint& a, const cv::KeyPoint& b) {
   return a.pt == b.pt && a.octave == b.octave && a.angle == b.angle;
 }
 
-class RgbdFrameBuilder final : public FrameBuilder {
+class InputFrameBuilder final : public FrameBuilder {
  public:
-  RgbdFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
-                   std::shared_ptr<const ScalePyramid> pyramid)
+  InputFrameBuilder(const OrbConfig& orb, std::shared_ptr<const CameraModel> camera,
+                    std::shared_ptr<const ScalePyramid> pyramid)
       : extractor_(orb), camera_(std::move(camera)), pyramid_(std::move(pyramid)) {}
 
-  void extract(const RgbdFrame&, const cv::Mat& gray, const cv::Mat& mask,
+  void extract(const InputFrame&, const cv::Mat& gray, const cv::Mat& mask,
                OrbFeatures& features) override {
     extractor_.extract(gray, mask, features);
   }
 
-  cv::Mat depth_image(const RgbdFrame& frame) override { return frame.depth; }
+  cv::Mat depth_image(const InputFrame& frame) override { return frame.depth; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+  Frame build(std::uint64_t id, const InputFrame& frame, OrbFeatures&& features, const cv::Mat&,
               const Eigen::Vector3d& angular_velocity) override {
     return Frame(id, frame.timestamp, std::move(features.keypoints),
                  std::move(features.descriptors), frame.depth, camera_, pyramid_, angular_velocity);
@@ -38,7 +38,7 @@ class RgbdFrameBuilder final : public FrameBuilder {
 
  private:
   OrbExtractor extractor_;
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
 };
 
@@ -75,7 +75,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     return orb;
   }
 
-  StereoFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
+  StereoFrameBuilder(const OrbConfig& orb, std::shared_ptr<const CameraModel> camera,
                      std::shared_ptr<const ScalePyramid> pyramid, bool dense_depth)
       : left_extractor_(orb),
         camera_(std::move(camera)),
@@ -99,14 +99,14 @@ class StereoFrameBuilder final : public FrameBuilder {
   // mask or the map: a deterministic run starts them when the frame is announced, one frame
   // ahead, so they run while the frame before is tracked and its keyframe refined (time in
   // which the caller thread only waits) instead of on the frame's own path.
-  void prepare(const RgbdFrame& frame) override {
+  void prepare(const InputFrame& frame) override {
     if (frame.right.empty() || frame.right.size() != left_size(frame)) return;  // extract() says
     ImageWork& work = *images_[next_work_];
     next_work_ = 1 - next_work_;
     start(work, frame);
   }
 
-  void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
+  void extract(const InputFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
                OrbFeatures& features) override {
     check_pair(frame);
     current_ = find(frame);
@@ -124,7 +124,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     extracted_ = features.keypoints;
   }
 
-  cv::Mat depth_image(const RgbdFrame& frame) override {
+  cv::Mat depth_image(const InputFrame& frame) override {
     if (current_ != nullptr && current_->dense_done.valid() && current_->index == frame.index)
       return current_->dense_done.get();
     cv::Mat gray = frame.gray;
@@ -134,7 +134,7 @@ class StereoFrameBuilder final : public FrameBuilder {
 
   std::span<const float> keypoint_depths() const override { return depths_.depth; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+  Frame build(std::uint64_t id, const InputFrame& frame, OrbFeatures&& features, const cv::Mat&,
               const Eigen::Vector3d& angular_velocity) override {
     // The kept keypoints are an order-preserving subset of the extracted ones (dynamic removal
     // compacts in place): walk both lists to carry each kept keypoint's match over.
@@ -173,11 +173,11 @@ class StereoFrameBuilder final : public FrameBuilder {
     std::future<cv::Mat> dense_done;  // invalid when no dense depth is wanted
   };
 
-  static cv::Size left_size(const RgbdFrame& frame) {
+  static cv::Size left_size(const InputFrame& frame) {
     return frame.gray.empty() ? frame.bgr.size() : frame.gray.size();
   }
 
-  static void check_pair(const RgbdFrame& frame) {
+  static void check_pair(const InputFrame& frame) {
     if (frame.right.empty()) {
       throw Error("stereo camera: frame " + frame.name + " has no right image");
     }
@@ -191,7 +191,7 @@ class StereoFrameBuilder final : public FrameBuilder {
   }
 
   // `gray`: the left image in grey when the caller has it; otherwise the task converts it.
-  void start(ImageWork& work, const RgbdFrame& frame, cv::Mat gray = cv::Mat()) {
+  void start(ImageWork& work, const InputFrame& frame, cv::Mat gray = cv::Mat()) {
     if (gray.empty()) gray = frame.gray;
     // The slot's previous frame may have been announced and never processed (end of the run).
     if (work.right_done.valid()) work.right_done.wait();
@@ -211,7 +211,7 @@ class StereoFrameBuilder final : public FrameBuilder {
     }
   }
 
-  ImageWork* find(const RgbdFrame& frame) {
+  ImageWork* find(const InputFrame& frame) {
     for (const auto& work : images_) {
       if (work->right_done.valid() && work->index == frame.index &&
           work->timestamp == frame.timestamp)
@@ -223,7 +223,7 @@ class StereoFrameBuilder final : public FrameBuilder {
   OrbExtractor left_extractor_;
   StereoDepths depths_;                  // per extracted left keypoint
   std::vector<cv::KeyPoint> extracted_;  // the left keypoints depths_ belongs to
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   // CV_32F metres at full resolution from block matching at half resolution (nearest-neighbour
   // upsampling: interpolating across a depth edge would invent depths between the two surfaces).
@@ -264,18 +264,18 @@ class StereoFrameBuilder final : public FrameBuilder {
 // without one. The semantic mask masks the one image's extraction, as for RGB-D.
 class MonocularFrameBuilder final : public FrameBuilder {
  public:
-  MonocularFrameBuilder(const OrbConfig& orb, std::shared_ptr<const RgbdCamera> camera,
+  MonocularFrameBuilder(const OrbConfig& orb, std::shared_ptr<const CameraModel> camera,
                         std::shared_ptr<const ScalePyramid> pyramid)
       : extractor_(orb), camera_(std::move(camera)), pyramid_(std::move(pyramid)) {}
 
-  void extract(const RgbdFrame&, const cv::Mat& gray, const cv::Mat& mask,
+  void extract(const InputFrame&, const cv::Mat& gray, const cv::Mat& mask,
                OrbFeatures& features) override {
     extractor_.extract(gray, mask, features);
   }
 
-  cv::Mat depth_image(const RgbdFrame&) override { return {}; }
+  cv::Mat depth_image(const InputFrame&) override { return {}; }
 
-  Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features, const cv::Mat&,
+  Frame build(std::uint64_t id, const InputFrame& frame, OrbFeatures&& features, const cv::Mat&,
               const Eigen::Vector3d& angular_velocity) override {
     return Frame(id, frame.timestamp, std::move(features.keypoints),
                  std::move(features.descriptors), cv::Mat(), camera_, pyramid_, angular_velocity);
@@ -301,7 +301,7 @@ class MonocularFrameBuilder final : public FrameBuilder {
 
  private:
   OrbExtractor extractor_;
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
 };
 
@@ -326,7 +326,7 @@ SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options) {
 }
 
 std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
-                                                 std::shared_ptr<const RgbdCamera> camera,
+                                                 std::shared_ptr<const CameraModel> camera,
                                                  std::shared_ptr<const ScalePyramid> pyramid,
                                                  bool dense_depth) {
   if (config.camera.type == SensorType::stereo) {
@@ -337,7 +337,7 @@ std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
     return std::make_unique<MonocularFrameBuilder>(config.orb, std::move(camera),
                                                    std::move(pyramid));
   }
-  return std::make_unique<RgbdFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
+  return std::make_unique<InputFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
 }
 
 }  // namespace pspslam

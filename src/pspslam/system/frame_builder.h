@@ -32,19 +32,19 @@ class FrameBuilder {
 
   // ORB features of the (left) image, none on `mask` (may be empty). `gray` is the frame's
   // (left) image in grey.
-  virtual void extract(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
+  virtual void extract(const InputFrame& frame, const cv::Mat& gray, const cv::Mat& mask,
                        OrbFeatures& features) = 0;
 
   // The frame will be extracted after the one in progress (deterministic runs announce each
   // frame before the one before it is processed): work that needs only its images may start
   // now. Frames are announced in the order they are extracted; one never announced is
   // extracted all the same.
-  virtual void prepare(const RgbdFrame&) {}
+  virtual void prepare(const InputFrame&) {}
 
   // The frame's depth image (CV_32FC1 metres, 0 = none) for the dynamic pipeline: the geometry
   // stage compares it with its reference views around projected pixels and the culler reads it
   // at map points, so it must be dense. RGB-D: the sensor's image; stereo: computed here.
-  virtual cv::Mat depth_image(const RgbdFrame& frame) = 0;
+  virtual cv::Mat depth_image(const InputFrame& frame) = 0;
 
   // Each extracted keypoint's own depth measurement (metres, <= 0: none), in extraction order,
   // for the geometry stage's candidates; empty: the stage reads depth_image() at the keypoint's
@@ -55,7 +55,7 @@ class FrameBuilder {
   // of the extracted ones). `depth` is what depth_image() returned, or empty when no dynamic
   // pipeline runs. `angular_velocity` (rad/s, camera frame): the tracker's, for the
   // rolling-shutter correction of a camera that has one (map/frame.h).
-  virtual Frame build(std::uint64_t id, const RgbdFrame& frame, OrbFeatures&& features,
+  virtual Frame build(std::uint64_t id, const InputFrame& frame, OrbFeatures&& features,
                       const cv::Mat& depth, const Eigen::Vector3d& angular_velocity) = 0;
 
   // How the map starts: one frame with depth (RGB-D, stereo) or two views (monocular).
@@ -80,7 +80,7 @@ SensorLimits apply_sensor_limits(SensorType type, SystemOptions& options);
 // The builder of `config.camera.type`. `dense_depth`: depth_image() will be called every frame
 // (a dynamic pipeline runs), so a stereo builder computes it beside the extraction.
 std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
-                                                 std::shared_ptr<const RgbdCamera> camera,
+                                                 std::shared_ptr<const CameraModel> camera,
                                                  std::shared_ptr<const ScalePyramid> pyramid,
                                                  bool dense_depth);
 

@@ -67,11 +67,11 @@
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/loop/loop_closing.h"
+#include "pspslam/map/camera_model.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/map/rgbd_camera.h"
 #include "pspslam/map/scale_pyramid.h"
 #include "pspslam/mapping/local_mapping.h"
 #include "pspslam/persistence/map_file.h"
@@ -172,8 +172,8 @@ class System::MappingConnection final : public KeyFrameSink {
 };
 
 System::System(const SystemConfig& config, SystemOptions options)
-    : camera_(std::make_shared<const RgbdCamera>(
-          RgbdCamera::from_config(config.camera, options.virtual_baseline))),
+    : camera_(std::make_shared<const CameraModel>(
+          CameraModel::from_config(config.camera, options.virtual_baseline))),
       pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
       frame_builder_(
           make_frame_builder(config, camera_, pyramid_, options.dynamic.mode != DynamicMode::off)),
@@ -261,7 +261,7 @@ System::System(const SystemConfig& config, SystemOptions options)
 
 System::~System() { shutdown(); }
 
-FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
+FrameReport System::track(const InputFrame& frame, const cv::Mat& dynamic_mask) {
   FrameReport report;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_ms();
@@ -285,19 +285,19 @@ FrameReport System::track(const RgbdFrame& frame, const cv::Mat& dynamic_mask) {
 
 FrameReport System::track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
                           const cv::Mat& dynamic_mask) {
-  RgbdFrame frame;
+  InputFrame frame;
   frame.timestamp = timestamp;
   frame.gray = gray;
   frame.depth = depth_metres;
   return track(frame, dynamic_mask);
 }
 
-void System::announce(const RgbdFrame& frame) {
+void System::announce(const InputFrame& frame) {
   frame_builder_->prepare(frame);
   if (dynamic_) dynamic_->announce(frame);
 }
 
-FrameReport System::process(const RgbdFrame& frame) {
+FrameReport System::process(const InputFrame& frame) {
   if (!dynamic_) {
     FrameReport report = track(frame);
     if (record_keypoint_fates_) record_fates_of_tracked_frame(report.keypoints);

@@ -22,8 +22,8 @@ class LoopClosing;
 class Map;
 class OrbExtractor;
 class PlaceRecognition;
-struct RgbdFrame;
-struct RgbdCamera;
+struct InputFrame;
+struct CameraModel;
 struct ScalePyramid;
 
 // Place recognition: bag-of-words vocabulary and keyframe database.
@@ -129,7 +129,7 @@ class System {
 
   // Tracks one frame. `dynamic_mask` (CV_8UC1, non-zero = do not extract features there) may
   // be empty. Uses frame.gray when present, else converts frame.bgr.
-  FrameReport track(const RgbdFrame& frame, const cv::Mat& dynamic_mask = {});
+  FrameReport track(const InputFrame& frame, const cv::Mat& dynamic_mask = {});
   // RGB-D only (tests): the frame from its parts.
   FrameReport track(Timestamp timestamp, const cv::Mat& gray, const cv::Mat& depth_metres,
                     const cv::Mat& dynamic_mask = {});
@@ -137,11 +137,11 @@ class System {
   // The full PSPNet-SLAM path (options.dynamic): semantic mask + geometry verdicts -> dynamic
   // features removed -> tracking -> culling of map points on dynamic pixels. With mode `off` it
   // is track(frame). frame.bgr is required for the semantic modes.
-  FrameReport process(const RgbdFrame& frame);
+  FrameReport process(const InputFrame& frame);
   // Hands a frame to the semantic thread ahead of process(frame), so that its segmentation
   // overlaps the tracking of the frame before (deterministic mode). Frames must be announced
   // in the order they are processed; a frame not announced is submitted by process().
-  void announce(const RgbdFrame& frame);
+  void announce(const InputFrame& frame);
 
   // Lets local mapping finish its queue and loop closing its loops and global bundle
   // adjustment, then stops their threads. Idempotent.
@@ -194,7 +194,7 @@ class System {
                                    std::vector<KeypointRecord>& records);
   void record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const;
 
-  std::shared_ptr<const RgbdCamera> camera_;
+  std::shared_ptr<const CameraModel> camera_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   // Per-sensor: extraction, depth and the Frame (system/frame_builder.h).
   std::unique_ptr<FrameBuilder> frame_builder_;

@@ -44,7 +44,7 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
 
 Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
                                            double sigma_rate, FramePoseBuffers& buffers) {
-  const RgbdCamera& camera = frame.camera();
+  const CameraModel& camera = frame.camera();
   if (camera.rolling_shutter_readout_s == 0.0) return Eigen::Vector3d::Zero();
   gather_observations(frame, /*inliers_only=*/true, buffers);
   buffers.row_times.clear();

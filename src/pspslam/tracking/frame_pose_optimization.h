@@ -30,7 +30,7 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
                                            FramePoseBuffers& buffers,
                                            const PosePrior* prior = nullptr);
 
-// Rolling shutter (RgbdCamera::rolling_shutter_readout_s != 0): the pose and the rotation rate of
+// Rolling shutter (CameraModel::rolling_shutter_readout_s != 0): the pose and the rotation rate of
 // `frame` refined together on its inlier matches (optimize/rolling_shutter_pose.h, prior
 // `sigma_rate` rad/s), the pose set and the keypoints moved by the rate correction, which is
 // returned (rad/s, camera frame; zero for a global shutter, which changes nothing).

@@ -1,12 +1,12 @@
-#include "pspslam/map/rgbd_camera.h"
+#include "pspslam/map/camera_model.h"
 
 #include <algorithm>
 #include <vector>
 
 namespace pspslam {
 
-RgbdCamera RgbdCamera::from_config(const CameraConfig& camera, double virtual_baseline) {
-  RgbdCamera c;
+CameraModel CameraModel::from_config(const CameraConfig& camera, double virtual_baseline) {
+  CameraModel c;
   c.pinhole = camera.pinhole;
   // A stereo pair has a real baseline: its right coordinate is measured, not derived from depth.
   // A monocular camera has none: no keypoint has a depth, and a baseline would only make local

@@ -5,10 +5,11 @@
 
 namespace pspslam {
 
-// The sensor as the SLAM core sees it: an undistorted pinhole camera plus the virtual stereo
-// baseline that turns a depth reading into a right-image coordinate u_r = u - bf / z
-// (ORB-SLAM2's RGB-D treatment), and the depth below which a point counts as "close".
-struct RgbdCamera {
+// Any sensor as the SLAM core sees it: an undistorted pinhole camera plus a stereo baseline
+// (a stereo rig's real one; for RGB-D the virtual one that turns a depth reading into a
+// right-image coordinate u_r = u - bf / z, ORB-SLAM2's treatment; none for monocular), and the
+// depth below which a point counts as "close".
+struct CameraModel {
   PinholeCamera pinhole;
   double bf = 0.0;                         // fx * virtual baseline [pixel * metre]
   double depth_threshold = 4.0;            // metres
@@ -21,7 +22,7 @@ struct RgbdCamera {
 
   // `virtual_baseline` in metres (ORB-SLAM2 uses 0.08 for Kinect-class sensors); a stereo
   // camera uses its config's real baseline instead.
-  static RgbdCamera from_config(const CameraConfig& camera, double virtual_baseline);
+  static CameraModel from_config(const CameraConfig& camera, double virtual_baseline);
 
   bool in_bounds(double u, double v) const {
     return u >= min_x && u < max_x && v >= min_y && v < max_y;

@@ -23,6 +23,7 @@
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
 #include "pspslam/system/system.h"
+#include "support/input_frames.h"
 
 namespace pspslam {
 namespace {
@@ -56,7 +57,8 @@ class MapFileTest : public ::testing::Test {
       scene.render(i, frame, 1);
       StoredFrame stored{scene.timestamp(i), {}, frame.depth_sensor.clone()};
       cv::cvtColor(frame.bgr, stored.gray, cv::COLOR_BGR2GRAY);
-      const FrameReport report = system.track(stored.timestamp, stored.gray, stored.depth);
+      const FrameReport report =
+          system.process(grey_depth_frame(stored.timestamp, stored.gray, stored.depth));
       ASSERT_TRUE(report.tracking.T_world_camera) << "frame " << i;
       frames_->push_back(std::move(stored));
     }
@@ -214,7 +216,8 @@ TEST_F(MapFileTest, LocalisationInTheLoadedMapReproducesTheTrajectory) {
   double max_difference = 0.0;
   for (size_t i = 0; i < kFrames; ++i) {
     const StoredFrame& frame = (*frames_)[i];
-    const FrameReport report = system.track(frame.timestamp, frame.gray, frame.depth);
+    const FrameReport report =
+        system.process(grey_depth_frame(frame.timestamp, frame.gray, frame.depth));
     ASSERT_TRUE(report.tracking.T_world_camera) << "frame " << i << " not localised";
     if (i == 0) {
       EXPECT_EQ(report.tracking.method, TrackingMethod::kRelocalisation);

@@ -11,6 +11,7 @@
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
 #include "pspslam/system/system.h"
+#include "support/input_frames.h"
 
 namespace pspslam {
 namespace {
@@ -31,7 +32,7 @@ TEST(KeyFrameIndexing, DatabaseHoldsExactlyTheMapsKeyframesAfterLocalMapping) {
   for (size_t i = 0; i < scene.frame_count(); ++i) {
     scene.render(i, frame, 1);
     cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-    system.track(scene.timestamp(i), gray, frame.depth_sensor);
+    system.process(grey_depth_frame(scene.timestamp(i), gray, frame.depth_sensor));
   }
   system.shutdown();
 

@@ -26,6 +26,7 @@
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
 #include "pspslam/system/system.h"
+#include "support/input_frames.h"
 
 namespace pspslam {
 namespace {
@@ -46,14 +47,10 @@ TEST(System, TracksAShortStaticSyntheticSequenceWithinOneCentimetre) {
   SynthFrame frame;
   for (size_t i = 0; i < scene.frame_count(); ++i) {
     scene.render(i, frame, 1);
-    const FrameReport report = system.track(
-        scene.timestamp(i),
-        [&] {
-          cv::Mat gray;
-          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-          return gray;
-        }(),
-        frame.depth_sensor);
+    cv::Mat gray;
+    cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    const FrameReport report =
+        system.process(grey_depth_frame(scene.timestamp(i), gray, frame.depth_sensor));
     ASSERT_TRUE(report.tracking.T_world_camera.has_value()) << "frame " << i << " lost";
     estimate.push_back({scene.timestamp(i), *report.tracking.T_world_camera});
   }
@@ -139,7 +136,7 @@ TEST(System, ABlackFrameIsReportedLostWithoutAPoseAndTrackingResumes) {
       gray.setTo(0);
       depth = cv::Mat::zeros(depth.size(), CV_32F);
     }
-    const FrameReport report = system.track(scene.timestamp(i), gray, depth);
+    const FrameReport report = system.process(grey_depth_frame(scene.timestamp(i), gray, depth));
     if (i == 20) {
       EXPECT_EQ(report.tracking.state, TrackingState::kLost);
       EXPECT_FALSE(report.tracking.T_world_camera.has_value());

@@ -9,6 +9,7 @@
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
 #include "pspslam/system/system.h"
+#include "support/input_frames.h"
 
 namespace pspslam {
 namespace {
@@ -42,7 +43,8 @@ class Feeder {
       gray = cv::Mat::zeros(480, 640, CV_8UC1);
       depth = cv::Mat::zeros(480, 640, CV_32FC1);
     }
-    const FrameReport report = system_.track(1e6 + kTimeStep * fed_++, gray, depth);
+    const FrameReport report = system_.process(
+        grey_depth_frame(1e6 + kTimeStep * static_cast<double>(fed_++), gray, depth));
     Step step;
     step.tracked = report.tracking.T_world_camera.has_value();
     step.method = report.tracking.method;

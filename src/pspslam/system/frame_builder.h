@@ -12,7 +12,7 @@
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/mapping/local_mapping_options.h"
-#include "pspslam/system/system.h"
+#include "pspslam/system/system_options.h"
 #include "pspslam/tracking/map_initializer.h"
 
 namespace pspslam {

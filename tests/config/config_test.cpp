@@ -7,6 +7,8 @@
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
+#include "pspslam/feature/orb_config.h"
+#include "pspslam/geometry/geometry_config.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -32,9 +34,12 @@ std::filesystem::path write_file(const std::filesystem::path& dir, const std::st
   return file;
 }
 
+// The error of loading `file` and reading every module's section, as a System does.
 std::string load_error(const std::filesystem::path& file) {
   try {
-    load_config(file);
+    const SystemConfig config = load_config(file);
+    read_orb_config(config.orb);
+    read_geometry_config(config.geometry);
   } catch (const Error& e) {
     return e.what();
   }
@@ -66,12 +71,12 @@ TEST(Config, SaveLoadRoundTrip) {
   config.camera.depth_shift_x = -2;
   config.camera.depth_shift_y = 1;
   config.camera.rolling_shutter_readout_s = -0.0275;  // 15 fps: within 1/fps, bottom row first
-  config.orb.n_features = 1500;
-  config.orb.scale_factor = 1.3;
-  config.orb.n_levels = 6;
-  config.orb.initial_fast_threshold = 25;
-  config.orb.min_fast_threshold = 9;
-  config.orb.mask_compensation = true;
+  config.orb = parse_config(std::string(kValidCamera) +
+                                "orb:\n  n_features: 1500\n  scale_factor: 1.3\n  n_levels: 6\n"
+                                "  initial_fast_threshold: 25\n  min_fast_threshold: 9\n"
+                                "  mask_compensation: true\n",
+                            "orb.yaml")
+                   .orb;
   save_config(dir / "saved.yaml", config);
   const SystemConfig loaded = load_config(dir / "saved.yaml");
   EXPECT_EQ(loaded.camera.name, config.camera.name);
@@ -90,19 +95,20 @@ TEST(Config, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded.camera.depth_shift_x, -2);
   EXPECT_EQ(loaded.camera.depth_shift_y, 1);
   EXPECT_EQ(loaded.camera.rolling_shutter_readout_s, -0.0275);
-  EXPECT_EQ(loaded.orb.n_features, 1500);
-  EXPECT_EQ(loaded.orb.scale_factor, 1.3);
-  EXPECT_EQ(loaded.orb.n_levels, 6);
-  EXPECT_EQ(loaded.orb.initial_fast_threshold, 25);
-  EXPECT_EQ(loaded.orb.min_fast_threshold, 9);
-  EXPECT_TRUE(loaded.orb.mask_compensation);
-  // Off (the default) is not written, so configs written here load in builds without the key.
-  config.orb.mask_compensation = false;
+  const OrbConfig orb = read_orb_config(loaded.orb);
+  EXPECT_EQ(orb.n_features, 1500);
+  EXPECT_EQ(orb.scale_factor, 1.3);
+  EXPECT_EQ(orb.n_levels, 6);
+  EXPECT_EQ(orb.initial_fast_threshold, 25);
+  EXPECT_EQ(orb.min_fast_threshold, 9);
+  EXPECT_TRUE(orb.mask_compensation);
+  // A module section that was not given is not written: its keys keep their defaults.
+  config.orb = {};
   save_config(dir / "saved_off.yaml", config);
   std::ifstream saved(dir / "saved_off.yaml");
   const std::string text((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(text.find("mask_compensation"), std::string::npos) << text;
-  EXPECT_FALSE(load_config(dir / "saved_off.yaml").orb.mask_compensation);
+  EXPECT_EQ(text.find("orb"), std::string::npos) << text;
+  EXPECT_FALSE(read_orb_config(load_config(dir / "saved_off.yaml").orb).mask_compensation);
   // A global shutter (0, the default) is not written either.
   config.camera.rolling_shutter_readout_s = 0.0;
   save_config(dir / "saved_global.yaml", config);
@@ -147,8 +153,8 @@ TEST(Config, ValidMinimalConfigTakesOrbDefaults) {
   EXPECT_EQ(config.camera.name, "test");
   EXPECT_EQ(config.camera.pinhole.fy, 501.25);
   EXPECT_EQ(config.camera.pinhole.distortion[4], 0.0);
-  EXPECT_EQ(config.orb.n_features, 1000);
-  EXPECT_FALSE(config.orb.mask_compensation);
+  EXPECT_EQ(read_orb_config(config.orb).n_features, 1000);
+  EXPECT_FALSE(read_orb_config(config.orb).mask_compensation);
   // Without the key, depth is weighed as ORB-SLAM2 does (virtual right coordinate).
   EXPECT_EQ(config.camera.depth_noise, CameraConfig::DepthNoise::none);
 }
@@ -249,19 +255,16 @@ TEST(Config, GeometrySectionSetsTheStageAndRoundTrips) {
   expected.region.max_grow_radius_m = 1.25f;
   expected.search.band_width_px = 60.0f;
   expected.multiview.disagreement = DepthDisagreement::either_sign;
-  EXPECT_TRUE(config.geometry == expected);
-  EXPECT_TRUE(load_config(write_file(dir, kValidCamera)).geometry == GeometryParams{});
+  EXPECT_TRUE(read_geometry_config(config.geometry) == expected);
+  EXPECT_TRUE(read_geometry_config(load_config(write_file(dir, kValidCamera)).geometry) ==
+              GeometryParams{});
 
-  SystemConfig changed = config;
-  changed.geometry.homography.inlier_threshold_px = 1.7;
-  changed.geometry.region.static_barrier_radius_px = 3.3f;
-  changed.geometry.references.older_view_gain_share = 0.35;
-  changed.geometry.previous_mask_prior = false;
-  save_config(dir / "saved.yaml", changed);
-  EXPECT_TRUE(load_config(dir / "saved.yaml").geometry == changed.geometry);
-  // The defaults are not written, so configs written here load in builds without the section.
+  // Saved as read, so the stage reads back the same parameters.
+  save_config(dir / "saved.yaml", config);
+  EXPECT_TRUE(read_geometry_config(load_config(dir / "saved.yaml").geometry) == expected);
+  // A config without the section writes none, so it loads in builds without the section.
   SystemConfig plain = config;
-  plain.geometry = GeometryParams{};
+  plain.geometry = {};
   save_config(dir / "plain.yaml", plain);
   std::ifstream saved(dir / "plain.yaml");
   const std::string text((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
@@ -346,7 +349,7 @@ TEST(Config, InvalidValues) {
             distortion.string() +
                 ": key 'camera.distortion' must list 4 or 5 values (k1 k2 p1 p2 [k3]), got 2");
   const auto scale = write_file(dir, std::string(kValidCamera) + "orb:\n  scale_factor: 1.0\n");
-  EXPECT_EQ(load_error(scale), scale.string() + ": key 'orb.scale_factor' must be > 1");
+  EXPECT_EQ(load_error(scale), scale.string() + ":14: key 'orb.scale_factor' must be > 1");
   const auto noise = write_file(dir, std::string(kValidCamera) + "  depth_noise: kinect\n");
   EXPECT_EQ(load_error(noise),
             noise.string() + ": key 'camera.depth_noise' must be none or kinect_v1, got 'kinect'");

@@ -101,7 +101,8 @@ class MapFileTest : public ::testing::Test {
     Map map;
     try {
       load_map(file, map, std::make_shared<const CameraModel>(camera),
-               std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb)));
+               std::make_shared<const ScalePyramid>(
+                   ScalePyramid::from_config(read_orb_config(config.orb))));
     } catch (const Error& e) {
       EXPECT_EQ(map.num_keyframes(), 0u) << "a failed load must leave the map untouched";
       return e.what();
@@ -129,10 +130,10 @@ class MapFileTest : public ::testing::Test {
 TEST_F(MapFileTest, LoadRebuildsTheSameKeyframesPointsAndGraph) {
   const SystemConfig config = synthetic_system_config();
   Map map;
-  const MapFileSummary summary =
-      load_map(map_file(), map,
-               std::make_shared<const CameraModel>(CameraModel::from_config(config.camera, 0.08)),
-               std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb)));
+  const MapFileSummary summary = load_map(
+      map_file(), map,
+      std::make_shared<const CameraModel>(CameraModel::from_config(config.camera, 0.08)),
+      std::make_shared<const ScalePyramid>(ScalePyramid::from_config(read_orb_config(config.orb))));
   EXPECT_EQ(summary.keyframes, keyframes_saved_);
   EXPECT_EQ(summary.map_points, points_saved_);
   EXPECT_EQ(summary.bytes, std::filesystem::file_size(map_file()));

@@ -131,99 +131,16 @@ CameraConfig read_camera(YamlSection section) {
   return camera;
 }
 
-OrbConfig read_orb(YamlSection section) {
-  OrbConfig orb;
-  orb.n_features = section.optional("n_features", orb.n_features);
-  orb.scale_factor = section.optional("scale_factor", orb.scale_factor);
-  orb.n_levels = section.optional("n_levels", orb.n_levels);
-  orb.initial_fast_threshold =
-      section.optional("initial_fast_threshold", orb.initial_fast_threshold);
-  orb.min_fast_threshold = section.optional("min_fast_threshold", orb.min_fast_threshold);
-  orb.mask_compensation = section.optional("mask_compensation", orb.mask_compensation);
-  require_positive(orb.n_features, section, "n_features");
-  if (!(orb.scale_factor > 1.0)) {
-    throw Error(section.file() + ": key '" + section.qualified("scale_factor") + "' must be > 1");
-  }
-  require_positive(orb.n_levels, section, "n_levels");
-  section.finish();
-  return orb;
-}
-
-GeometryParams read_geometry(YamlSection section) {
-  YamlSection search = section.section("search");
-  if (search.contains("strategy")) {
-    throw search.invalid("strategy",
-                         "is not a config key: pspslam run --dynamic chooses the search (full: "
-                         "ant_colony, exhaustive: every point)");
-  }
-  // A library output (the previous mask warped into the frame) that a run never reads.
-  if (section.contains("output_warped_previous_mask")) {
-    throw section.invalid("output_warped_previous_mask",
-                          "is not a config key: a run does not use the warped mask");
-  }
-  return GeometryParams::from_yaml(section);
-}
-
-// Every key of the geometry stage but the search strategy (chosen by --dynamic) and the library
-// output a run does not read (refused by read_geometry).
-void write_geometry(YAML::Emitter& out, const GeometryParams& g) {
-  const auto key = [&out](const char* name) -> YAML::Emitter& {
-    return out << YAML::Key << name << YAML::Value;
-  };
-  key("geometry") << YAML::BeginMap;
-  key("homography") << YAML::BeginMap;
-  key("inlier_threshold_px") << g.homography.inlier_threshold_px;
-  key("max_ransac_iterations") << g.homography.max_ransac_iterations;
-  key("ransac_confidence") << g.homography.ransac_confidence;
-  key("lm_max_iterations") << g.homography.lm_max_iterations;
-  key("random_seed") << g.homography.random_seed;
-  out << YAML::EndMap;
-  const MultiViewParams& m = g.multiview;
-  key("multiview") << YAML::BeginMap;
-  key("depth_threshold_abs_m") << m.depth_threshold_abs_m;
-  key("depth_threshold_relative") << m.depth_threshold_relative;
-  key("disagreement") << (m.disagreement == DepthDisagreement::farther_only ? "farther_only"
-                                                                            : "either_sign");
-  key("max_parallax_deg") << m.max_parallax_deg;
-  key("reference_patch_radius") << m.reference_patch_radius;
-  key("min_dynamic_vote_fraction") << m.min_dynamic_vote_fraction;
-  key("max_reference_views") << m.max_reference_views;
-  key("min_depth_m") << m.min_depth_m;
-  key("max_depth_m") << m.max_depth_m;
-  out << YAML::EndMap;
-  const AntColonyParams& a = g.search;
-  key("search") << YAML::BeginMap;
-  key("search_radius_px") << a.search_radius_px;
-  key("band_width_px") << a.band_width_px;
-  key("node_spacing_px") << a.node_spacing_px;
-  key("lane_spacing_px") << a.lane_spacing_px;
-  key("alternate_lanes") << a.alternate_lanes;
-  key("max_band_rounds") << a.max_band_rounds;
-  out << YAML::EndMap;
-  const RegionGrowParams& r = g.region;
-  key("region") << YAML::BeginMap;
-  key("enabled") << r.enabled;
-  key("stride") << r.stride;
-  key("max_step_abs_m") << r.max_step_abs_m;
-  key("max_step_relative") << r.max_step_relative;
-  key("max_depth_from_seed_m") << r.max_depth_from_seed_m;
-  key("max_grow_radius_px") << r.max_grow_radius_px;
-  key("max_grow_radius_m") << r.max_grow_radius_m;
-  key("min_seeds_per_region") << r.min_seeds_per_region;
-  key("max_region_samples") << r.max_region_samples;
-  key("static_barrier_radius_px") << r.static_barrier_radius_px;
-  key("dilation_px") << r.dilation_px;
-  out << YAML::EndMap;
-  key("references") << YAML::BeginMap;
-  key("wanted_coverage") << g.references.wanted_coverage;
-  key("point_stride") << g.references.point_stride;
-  key("older_view_gain_share") << g.references.older_view_gain_share;
-  out << YAML::EndMap;
-  key("previous_mask_prior") << g.previous_mask_prior;
-  out << YAML::EndMap;
-}
-
 }  // namespace
+
+ConfigSection::ConfigSection(const YAML::Node& node, std::string document, std::string key)
+    : node_(std::make_shared<const YAML::Node>(node)),
+      document_(std::move(document)),
+      key_(std::move(key)) {}
+
+YamlSection ConfigSection::reader() const {
+  return YamlSection(node_ ? *node_ : YAML::Node(), document_, key_);
+}
 
 SensorType parse_sensor_type(const std::string& name, const std::string& where) {
   if (name == "rgbd") return SensorType::rgbd;
@@ -251,8 +168,12 @@ SystemConfig read_config(const YAML::Node& root, const std::string& name) {
   if (!top.contains("camera")) throw Error(name + ": missing key 'camera'");
   SystemConfig config;
   config.camera = read_camera(top.section("camera"));
-  config.orb = read_orb(top.section("orb"));
-  config.geometry = read_geometry(top.section("geometry"));
+  for (const char* key : {"orb", "geometry"}) {
+    top.section(key);  // its keys are the module's to read; here it must only be a mapping
+  }
+  if (root["orb"] && root["orb"].IsMap()) config.orb = ConfigSection(root["orb"], name, "orb");
+  if (root["geometry"] && root["geometry"].IsMap())
+    config.geometry = ConfigSection(root["geometry"], name, "geometry");
   top.finish();
   return config;
 }
@@ -283,7 +204,6 @@ SystemConfig parse_config(const std::string& yaml, const std::string& name) {
 void save_config(const std::filesystem::path& file, const SystemConfig& config) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
-  out.SetFloatPrecision(9);  // the geometry stage's float keys read back to the same value
   out << YAML::BeginMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   const PinholeCamera& p = config.camera.pinhole;
@@ -323,18 +243,9 @@ void save_config(const std::filesystem::path& file, const SystemConfig& config) 
         << std::vector<int>{config.camera.depth_shift_x, config.camera.depth_shift_y};
   }
   out << YAML::EndMap;
-  out << YAML::Key << "orb" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "n_features" << YAML::Value << config.orb.n_features;
-  out << YAML::Key << "scale_factor" << YAML::Value << config.orb.scale_factor;
-  out << YAML::Key << "n_levels" << YAML::Value << config.orb.n_levels;
-  out << YAML::Key << "initial_fast_threshold" << YAML::Value << config.orb.initial_fast_threshold;
-  out << YAML::Key << "min_fast_threshold" << YAML::Value << config.orb.min_fast_threshold;
-  // Written only when switched on, so that sequences rendered by this build still load in
-  // builds that predate the key (experiments compare builds on the same sequences).
-  if (config.orb.mask_compensation) out << YAML::Key << "mask_compensation" << YAML::Value << true;
-  out << YAML::EndMap;
-  // Likewise only when it differs from the defaults.
-  if (config.geometry != GeometryParams{}) write_geometry(out, config.geometry);
+  if (!config.orb.empty()) out << YAML::Key << "orb" << YAML::Value << *config.orb.node();
+  if (!config.geometry.empty())
+    out << YAML::Key << "geometry" << YAML::Value << *config.geometry.node();
   out << YAML::EndMap;
   std::ofstream stream(file);
   if (!stream) throw Error(file.string() + ": cannot write config file");

@@ -1,10 +1,14 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "pspslam/camera/pinhole_camera.h"
-#include "pspslam/geometry/geometry_stage.h"
+
+namespace YAML {
+class Node;
+}
 
 namespace pspslam {
 
@@ -52,32 +56,39 @@ struct CameraConfig {
   int depth_shift_y = 0;
 };
 
-// ORB extractor parameters as ORB-SLAM2 defines them (YAML section `orb:`, all optional).
-struct OrbConfig {
-  int n_features = 1000;
-  double scale_factor = 1.2;
-  int n_levels = 8;
-  int initial_fast_threshold = 20;
-  int min_fast_threshold = 7;
-  // When an extraction mask removes part of the image, keep the kept-keypoint count near
-  // n_features: a pyramid level with fewer unmasked corners than its share is searched again at
-  // min_fast_threshold, and what it still lacks goes to the levels that have corners to spare
-  // (ORB-SLAM2 has neither, so a frame mostly covered by people keeps far fewer keypoints than
-  // asked for). Frames without masked pixels are extracted exactly as with it off. YAML key
-  // `mask_compensation`. Off by default: on real crowded sequences it keeps the count but makes
-  // every mode less accurate, for reasons not established (docs/decisions/mask-compensation.md).
-  bool mask_compensation = false;
+class YamlSection;
+
+// A section of the config document that a module owns (`orb:`, `geometry:`), kept as YAML until
+// that module reads it with its own keys and checks (feature/orb_config.h,
+// geometry/geometry_config.h), as each module owns its parameters. An empty section reads as
+// every key at its default.
+class ConfigSection {
+ public:
+  ConfigSection() = default;
+  // `document` names the config in errors (its file); `key` is the section's top-level key.
+  ConfigSection(const YAML::Node& node, std::string document, std::string key);
+
+  // A strict reader of the section (core/yaml_section.h): errors name the document, the line and
+  // the key; finish() refuses the keys its module did not read.
+  YamlSection reader() const;
+  bool empty() const { return node_ == nullptr; }
+  const YAML::Node* node() const { return node_.get(); }
+
+ private:
+  std::shared_ptr<const YAML::Node> node_;  // shared: a config is copied freely, never changed
+  std::string document_;
+  std::string key_;
 };
 
+// The config document: the camera, which every module needs and config/ reads, and the
+// sections each module reads itself.
 struct SystemConfig {
   CameraConfig camera;
-  OrbConfig orb;
-  // The OC multi-view geometry stage (paper III.B/C; YAML section `geometry:` with the
-  // sub-sections homography, multiview, search, region, references, every key optional). Which
-  // search runs is not a key: `pspslam run --dynamic` chooses it (full: the reverse ant colony,
-  // exhaustive: every point), so `geometry.search.strategy` is refused, as is
-  // `geometry.output_warped_previous_mask` (an output a run never reads).
-  GeometryParams geometry;
+  // ORB extraction (feature/orb_config.h), all keys optional.
+  ConfigSection orb;
+  // The OC multi-view geometry stage (paper III.B/C; geometry/geometry_config.h), with the
+  // sub-sections homography, multiview, search, region, references, every key optional.
+  ConfigSection geometry;
 };
 
 // Loads a config file. Any missing required key, unknown key or invalid value raises
@@ -87,7 +98,8 @@ SystemConfig load_config(const std::filesystem::path& file);
 // where load_config names the file.
 SystemConfig parse_config(const std::string& yaml, const std::string& name);
 
-// Writes a config that load_config reads back to the same values.
+// Writes a config that load_config reads back to the same values (the module sections as they
+// were read).
 void save_config(const std::filesystem::path& file, const SystemConfig& config);
 
 }  // namespace pspslam

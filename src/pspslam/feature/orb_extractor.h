@@ -5,7 +5,7 @@
 #include <array>
 #include <vector>
 
-#include "pspslam/config/config.h"
+#include "pspslam/feature/orb_config.h"
 #include "pspslam/feature/brief_pattern.h"
 #include "pspslam/feature/hamming.h"
 #include "pspslam/feature/keypoint_distribution.h"

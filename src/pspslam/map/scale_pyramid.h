@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "pspslam/config/config.h"
+#include "pspslam/feature/orb_config.h"
 
 namespace pspslam {
 

@@ -17,10 +17,10 @@ bool same_keypoint(const cv::KeyPoint& a, const cv::KeyPoint& b) {
   return a.pt == b.pt && a.octave == b.octave && a.angle == b.angle;
 }
 
-class InputFrameBuilder final : public FrameBuilder {
+class RgbdFrameBuilder final : public FrameBuilder {
  public:
-  InputFrameBuilder(const OrbConfig& orb, std::shared_ptr<const CameraModel> camera,
-                    std::shared_ptr<const ScalePyramid> pyramid)
+  RgbdFrameBuilder(const OrbConfig& orb, std::shared_ptr<const CameraModel> camera,
+                   std::shared_ptr<const ScalePyramid> pyramid)
       : extractor_(orb), camera_(std::move(camera)), pyramid_(std::move(pyramid)) {}
 
   void extract(const InputFrame&, const cv::Mat& gray, const cv::Mat& mask,
@@ -329,15 +329,15 @@ std::unique_ptr<FrameBuilder> make_frame_builder(const SystemConfig& config,
                                                  std::shared_ptr<const CameraModel> camera,
                                                  std::shared_ptr<const ScalePyramid> pyramid,
                                                  bool dense_depth) {
+  const OrbConfig orb = read_orb_config(config.orb);
   if (config.camera.type == SensorType::stereo) {
-    return std::make_unique<StereoFrameBuilder>(config.orb, std::move(camera), std::move(pyramid),
+    return std::make_unique<StereoFrameBuilder>(orb, std::move(camera), std::move(pyramid),
                                                 dense_depth);
   }
   if (config.camera.type == SensorType::monocular) {
-    return std::make_unique<MonocularFrameBuilder>(config.orb, std::move(camera),
-                                                   std::move(pyramid));
+    return std::make_unique<MonocularFrameBuilder>(orb, std::move(camera), std::move(pyramid));
   }
-  return std::make_unique<InputFrameBuilder>(config.orb, std::move(camera), std::move(pyramid));
+  return std::make_unique<RgbdFrameBuilder>(orb, std::move(camera), std::move(pyramid));
 }
 
 }  // namespace pspslam

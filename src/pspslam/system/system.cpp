@@ -62,6 +62,8 @@
 #include <vector>
 
 #include "pspslam/dynamic/dynamic_pipeline.h"
+#include "pspslam/feature/orb_config.h"
+#include "pspslam/geometry/geometry_config.h"
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/camera_model.h"
 #include "pspslam/map/keyframe.h"
@@ -204,11 +206,18 @@ SystemOptions effective_options(const SystemConfig& config, SystemOptions option
 
 }  // namespace
 
+void check_config_sections(const SystemConfig& config) {
+  read_orb_config(config.orb);
+  read_geometry_config(config.geometry);
+}
+
 System::System(const SystemConfig& config, SystemOptions requested)
     : camera_(std::make_shared<const CameraModel>(
           CameraModel::from_config(config.camera, requested.virtual_baseline))),
-      pyramid_(std::make_shared<const ScalePyramid>(ScalePyramid::from_config(config.orb))),
+      pyramid_(std::make_shared<const ScalePyramid>(
+          ScalePyramid::from_config(read_orb_config(config.orb)))),
       map_(std::make_shared<Map>()) {
+  check_config_sections(config);
   const SystemOptions options = effective_options(config, std::move(requested));
   back_end_wait_ = options.back_end_wait;
   if (options.place.needs_vocabulary()) {

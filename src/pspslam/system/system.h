@@ -44,6 +44,10 @@ struct MappingStats {
   double last_global_ba_seconds = 0.0;
 };
 
+// Reads every module's section of `config` as a System does: a bad key or value is an error
+// naming the file, the line and the key, raised before a run opens its input or starts a thread.
+void check_config_sections(const SystemConfig& config);
+
 // The SLAM system: creates the map and the threads, wires them together and stops them. Each
 // thread's loop is its own module: tracking (the caller's thread, system/tracking_module.h),
 // local mapping (mapping/), loop closing (loop/); the semantic thread belongs to the tracking

@@ -7,6 +7,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/core/clock.h"
+#include "pspslam/feature/orb_config.h"
+#include "pspslam/geometry/geometry_config.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
@@ -38,7 +40,7 @@ std::unique_ptr<DynamicPipeline> make_dynamic_pipeline(const SystemConfig& confi
   if (options.dynamic.mode == DynamicMode::off) return nullptr;
   DynamicOptions dynamic = options.dynamic;
   dynamic.semantic.thread_nice = options.background_thread_nice;
-  dynamic.geometry = config.geometry;
+  dynamic.geometry = read_geometry_config(config.geometry);
   return std::make_unique<DynamicPipeline>(dynamic, config.camera.pinhole, map);
 }
 
@@ -62,7 +64,7 @@ TrackingModule::TrackingModule(const SystemConfig& config, const SystemOptions& 
       tracker_(map, keyframe_sink, tracker_options(config, options),
                options.place.relocalization ? place_ : nullptr,
                frame_builder_->make_map_initializer(tracker_options(config, options))),
-      extractor_(std::make_unique<OrbExtractor>(config.orb)),
+      extractor_(std::make_unique<OrbExtractor>(read_orb_config(config.orb))),
       record_keypoint_fates_(options.record_keypoint_fates),
       dynamic_(make_dynamic_pipeline(config, options, map)) {}
 

@@ -36,13 +36,14 @@ struct FrameReport {
   std::vector<KeypointRecord> keypoints;
 };
 
-// What the tracking module needs from the threads behind it; System provides both.
+// What the tracking module needs from the threads behind it; System provides both. The defaults
+// wait for nothing: without local mapping there is nothing to wait for.
 struct BackEndHooks {
   // Blocks until the back end has caught up as SystemOptions::back_end_wait asks (does nothing
   // for BackEndWait::none).
-  std::function<void()> wait_for_back_end;
+  std::function<void()> wait_for_back_end = [] {};
   // Blocks until local mapping has finished every keyframe it holds.
-  std::function<void()> wait_for_local_mapping;
+  std::function<void()> wait_for_local_mapping = [] {};
 };
 
 // The caller thread's work: one frame from its images to its pose, the path of the paper's

@@ -65,7 +65,7 @@
 #include "pspslam/core/clock.h"
 #include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/camera_model.h"
 #include "pspslam/map/frame.h"

@@ -150,6 +150,42 @@ TEST(EurocSequence, RectifiedRowsAgreeAndDisparityMatchesDepth) {
   }
 }
 
+// cam0 alone (a monocular run): a dot at the projection of a known 3D point in the raw,
+// distorted image lands, once the frame is loaded, at its pinhole projection by the camera the
+// sequence reports; the ground truth is cam0's.
+TEST(EurocSequence, Cam0AloneIsUndistortedOntoItsReportedCamera) {
+  const fs::path dir = make_euroc("euroc_mono");
+  const fs::path mav = dir / "mav0";
+  fs::remove_all(mav / "cam1");
+  const EurocCamera left = read_euroc_camera(mav / "cam0" / "sensor.yaml");
+  const Eigen::Vector3d X(0.3, -0.2, 1.5);
+  std::vector<cv::Point2d> pixels;
+  cv::projectPoints(std::vector<cv::Point3d>{{X.x(), X.y(), X.z()}}, cv::Vec3d(0, 0, 0),
+                    cv::Vec3d(0, 0, 0), cv::Mat(left.K), left.distortion, pixels);
+  cv::Mat raw(kHeight, kWidth, CV_8UC1, cv::Scalar(0));
+  cv::circle(raw, cv::Point(cvRound(pixels[0].x * 16), cvRound(pixels[0].y * 16)), 3 * 16,
+             cv::Scalar(255), cv::FILLED, cv::LINE_AA, 4);
+  const std::string first = std::to_string(1403636579763555584LL) + ".png";
+  cv::imwrite((mav / "cam0" / "data" / first).string(), raw);
+
+  const SequenceSetup setup = open_sequence_with_config(dir, std::nullopt, nullptr);
+  const RecordedSequence& sequence = *setup.sequence;
+  EXPECT_EQ(sequence.sensor(), SensorType::monocular);
+  ASSERT_EQ(sequence.size(), 3u);
+  const CameraConfig& camera = setup.config.camera;
+  EXPECT_EQ(camera.type, SensorType::monocular);
+  EXPECT_FALSE(camera.pinhole.has_distortion());
+  EXPECT_EQ(camera.pinhole.width, kWidth);
+  const cv::Mat gray = sequence.load(0).gray;
+  const cv::Moments m = cv::moments(gray);
+  ASSERT_GT(m.m00, 0.0);
+  EXPECT_NEAR(m.m10 / m.m00, camera.pinhole.fx * X.x() / X.z() + camera.pinhole.cx, 0.3);
+  EXPECT_NEAR(m.m01 / m.m00, camera.pinhole.fy * X.y() / X.z() + camera.pinhole.cy, 0.3);
+  ASSERT_TRUE(sequence.ground_truth());
+  EXPECT_TRUE(sequence.ground_truth()->at(2).T_world_camera.isApprox(
+      Pose(Eigen::Translation3d(2, 2, 3)), 1e-9));
+}
+
 TEST(EurocSequence, MalformedFilesNameFileLineAndKey) {
   const fs::path dir = make_euroc("euroc_bad");
   const fs::path mav = dir / "mav0";

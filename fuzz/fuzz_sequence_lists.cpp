@@ -3,7 +3,7 @@
 // rgb.txt and depth.txt. The listed images do not exist, so the reader also meets its
 // "missing files" path.
 #include "fuzz_input.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/tum_sequence.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pspslam;
@@ -22,6 +22,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   SequenceOptions options;
   options.warnings = nullptr;
-  fuzz::expect_clean([&] { RgbdSequence::open(folder.path(), options); });
+  fuzz::expect_clean([&] { TumSequence::open(folder.path(), options); });
   return 0;
 }

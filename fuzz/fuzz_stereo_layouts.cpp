@@ -2,7 +2,8 @@
 // otherwise valid folder: KITTI times.txt, calib.txt or poses.txt, EuRoC cam0/data.csv or
 // cam1/sensor.yaml. Listed images do not exist (the missing-files path).
 #include "fuzz_input.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/euroc_sequence.h"
+#include "pspslam/io/kitti_sequence.h"
 #include "pspslam/io/trajectory_io.h"
 
 namespace {
@@ -30,7 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   switch (data[0] % 5) {
     case 0:
       folder.write("times.txt", text);
-      fuzz::expect_clean([&] { RgbdSequence::open_kitti(folder.path(), options); });
+      fuzz::expect_clean([&] { KittiSequence::open(folder.path(), options); });
       break;
     case 1:
       folder.write("calib.txt", text);
@@ -51,7 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                    data[0] % 5 == 4 ? text : std::string_view(kRightSensorYaml));
       folder.write("mav0/cam0/data.csv", data[0] % 5 == 3 ? text : "1,1.png\n");
       folder.write("mav0/cam1/data.csv", "1,1.png\n");
-      fuzz::expect_clean([&] { RgbdSequence::open_euroc(folder.path(), options); });
+      fuzz::expect_clean([&] { EurocSequence::open(folder.path(), options); });
       break;
     }
   }

@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/image_files.h"
 
 namespace pspslam::python {
 namespace {

@@ -292,7 +292,7 @@ void register_sequence(py::module_& m) {
       .def_property_readonly("config_file",
                              [](const PySequence& s) { return s.setup().config_file; })
       .def_property_readonly("folder",
-                             [](const PySequence& s) { return s.setup().sequence.directory(); });
+                             [](const PySequence& s) { return s.setup().sequence->directory(); });
   py::class_<PySequenceIterator>(m, "SequenceIterator")
       .def("__iter__", [](PySequenceIterator& it) -> PySequenceIterator& { return it; })
       .def("__next__", [](PySequenceIterator& it) {

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "pspslam/config/config.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/system/system.h"
 #include "system_options.h"
 

@@ -14,7 +14,7 @@ PySequence::PySequence(const std::filesystem::path& folder,
   if (sensor) sensor_type = parse_sensor_type(*sensor, "sensor");
   setup_ = std::make_shared<const SequenceSetup>(
       open_sequence_with_config(folder, config, &std::cerr, sensor_type));
-  frames_ = setup_->sequence.size();
+  frames_ = setup_->sequence->size();
   if (max_frames > 0 && max_frames < frames_) frames_ = max_frames;
 }
 
@@ -23,11 +23,11 @@ PyFrame PySequence::frame(size_t i) const {
     throw py::index_error("frame " + std::to_string(i) + " of a sequence of " +
                           std::to_string(frames_));
   py::gil_scoped_release release;
-  return {std::make_shared<const InputFrame>(setup_->sequence.load(i))};
+  return {std::make_shared<const InputFrame>(setup_->sequence->load(i))};
 }
 
 py::object PySequence::ground_truth() const {
-  const std::optional<Trajectory>& ground_truth = setup_->sequence.ground_truth();
+  const std::optional<Trajectory>& ground_truth = setup_->sequence->ground_truth();
   if (!ground_truth) return py::none();
   return trajectory_arrays(*ground_truth);
 }

@@ -22,7 +22,7 @@ void write_file(const std::filesystem::path& file, const std::string& header, co
 
 }  // namespace
 
-void write_fakenect_dump(const RgbdSequence& sequence, const std::filesystem::path& dir,
+void write_fakenect_dump(const RecordedSequence& sequence, const std::filesystem::path& dir,
                          const FakenectDumpOptions& options) {
   std::filesystem::create_directories(dir);
   std::ofstream index(dir / "INDEX.txt");

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/recorded_sequence.h"
 
 namespace pspslam::testing {
 
@@ -26,7 +26,7 @@ struct FakenectDumpOptions {
   double pause_s = 0.0;
 };
 
-void write_fakenect_dump(const RgbdSequence& sequence, const std::filesystem::path& dir,
+void write_fakenect_dump(const RecordedSequence& sequence, const std::filesystem::path& dir,
                          const FakenectDumpOptions& options = {});
 
 // The environment prefix that makes a command run against the dump instead of a device.

@@ -18,6 +18,7 @@
 #include "pspslam/core/latest_queue.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/io/sequence_source.h"
+#include "pspslam/io/tum_sequence.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -192,15 +193,15 @@ TEST(SequenceRecorder, WritesATumSequenceThatReadsBackFramePerFrame) {
       frame.depth.at<float>(0, 1) = 70.0f;  // beyond 65.535 m at factor 1000: clipped
       recorder.add(frame);
       // Flushed per frame: what is on disk now is a valid sequence (Ctrl-C leaves it so).
-      const RgbdSequence partial = RgbdSequence::open(dir / "rec", {.depth_factor = 1000.0});
+      const TumSequence partial = TumSequence::open(dir / "rec", {.depth_factor = 1000.0});
       EXPECT_EQ(partial.size(), static_cast<size_t>(i + 1));
     }
     EXPECT_EQ(recorder.frames(), 3u);
   }
   const SequenceSetup setup = open_sequence_with_config(dir / "rec", std::nullopt, nullptr);
   EXPECT_EQ(setup.config.camera.depth_factor, 1000.0);
-  ASSERT_EQ(setup.sequence.size(), 3u);
-  const InputFrame back = setup.sequence.load(2);
+  ASSERT_EQ(setup.sequence->size(), 3u);
+  const InputFrame back = setup.sequence->load(2);
   EXPECT_EQ(back.name, "rgb/1700000000.566667.png");
   EXPECT_NEAR(back.timestamp, 1700000000.5 + 2 / 30.0, 1e-6);
   EXPECT_NEAR(back.depth_timestamp, back.timestamp + 0.004, 1e-6);

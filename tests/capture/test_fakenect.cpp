@@ -11,6 +11,7 @@
 #include "fakenect_dump.h"
 #include "pspslam/capture/camera_spec.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/io/tum_sequence.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -71,7 +72,7 @@ class Fakenect : public ::testing::Test {
     const Result synth = pspslam("synth --out " + (root_ / "seq").string() + " --frames " +
                                  std::to_string(kFrames) + " --bodies 2 --seed 4 -q");
     ASSERT_EQ(synth.status, 0) << synth.output;
-    const RgbdSequence sequence = RgbdSequence::open(root_ / "seq");
+    const TumSequence sequence = TumSequence::open(root_ / "seq");
     testing::write_fakenect_dump(sequence, root_ / "dump",
                                  {.interval_s = 0.25, .first_ticks = 0xffffffffu - 30'000'000u});
     testing::write_fakenect_dump(sequence, root_ / "fast", {.interval_s = 0.15});
@@ -189,8 +190,8 @@ TEST_F(Fakenect, RecordingRoundTripsThroughRun) {
             std::string(std::istreambuf_iterator<char>(preset), {}));
 
   // The recorded depth is the sequence's depth through the Kinect's disparity steps.
-  const RgbdSequence original = RgbdSequence::open(root() / "seq");
-  const RgbdSequence recorded = RgbdSequence::open(rec);
+  const TumSequence original = TumSequence::open(root() / "seq");
+  const TumSequence recorded = TumSequence::open(rec);
   ASSERT_EQ(recorded.size(), 10u);
   const cv::Mat a = original.load(3).depth, b = recorded.load(3).depth;
   double worst = 0.0;
@@ -234,7 +235,7 @@ TEST_F(Fakenect, UnpluggedMidRunEndsWithStatusFourAndEveryOutput) {
   const Result record =
       replayed(root() / "short", "record --camera freenect --out " + rec.string() + " -q");
   EXPECT_EQ(record.status, 4) << record.output;
-  EXPECT_EQ(RgbdSequence::open(rec).size(), 12u);
+  EXPECT_EQ(TumSequence::open(rec).size(), 12u);
 }
 
 // At the device's rate a run that cannot keep up never holds the driver back: the newest frames
@@ -264,7 +265,7 @@ TEST_F(Fakenect, RunAtThirtyHertzCountsEveryDroppedFrame) {
 // 5) ends the run after 3 s of silence like an unplug: status 4, the reason, every output.
 TEST_F(Fakenect, SilentCameraEndsTheRunAfterThreeSeconds) {
   make_sequence_and_dumps();
-  const RgbdSequence sequence = RgbdSequence::open(root() / "seq");
+  const TumSequence sequence = TumSequence::open(root() / "seq");
   testing::write_fakenect_dump(sequence, root() / "stall",
                                {.frames = 10, .interval_s = 0.2, .pause_after = 5, .pause_s = 5.0});
   const Result run =
@@ -305,7 +306,7 @@ TEST_F(Fakenect, InterruptedRecordingIsAValidSequence) {
                               " record --camera freenect --out " + rec.string() +
                               " -q & pid=$!; sleep 2.5; kill -INT $pid; wait $pid");
   EXPECT_EQ(record.status, 0) << record.output;
-  const RgbdSequence recorded = RgbdSequence::open(rec);
+  const TumSequence recorded = TumSequence::open(rec);
   EXPECT_GE(recorded.size(), 4u);
   EXPECT_LT(recorded.size(), kFrames);
   EXPECT_EQ(data_lines(rec / "depth.txt"), recorded.size());

@@ -3,7 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include "pspslam/core/types.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 
 namespace pspslam {
 

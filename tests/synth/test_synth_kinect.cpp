@@ -13,8 +13,8 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
-#include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/io/tum_sequence.h"
 #include "pspslam/synth/kinect.h"
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
@@ -363,7 +363,7 @@ TEST(SynthKinect, DepthListCarriesTheDepthCaptureInstant) {
   }
   EXPECT_GE(offset_frames, 4);  // the offset is drawn per frame within +-16 ms
 
-  const RgbdSequence sequence = RgbdSequence::open(dir);
+  const TumSequence sequence = TumSequence::open(dir);
   ASSERT_EQ(sequence.size(), 6u);
   for (size_t i = 0; i < 6; ++i) {
     const InputFrame frame = sequence.load(i);

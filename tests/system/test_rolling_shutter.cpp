@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "pspslam/eval/ate.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/synth/scene.h"
 #include "pspslam/system/system.h"
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pspslam/eval/ate.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/map/map.h"
 #include "pspslam/synth/scene.h"

@@ -21,7 +21,7 @@
 
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/eval/ate.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"

@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 
 namespace pspslam {
 
-// Writes frames as a TUM-layout sequence that RgbdSequence reads back (`pspslam record`):
+// Writes frames as a TUM-layout sequence that TumSequence reads back (`pspslam record`):
 //   rgb/<t>.png     colour, 8-bit BGR PNG
 //   depth/<t>.png   depth, 16-bit PNG in units of 1/depth_factor m (0 = no reading)
 //   rgb.txt, depth.txt   `timestamp filename` lists

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "pspslam/core/types.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 
 namespace pspslam {
 

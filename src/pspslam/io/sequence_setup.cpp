@@ -4,6 +4,9 @@
 #include <sstream>
 
 #include "pspslam/core/error.h"
+#include "pspslam/io/euroc_sequence.h"
+#include "pspslam/io/kitti_sequence.h"
+#include "pspslam/io/tum_sequence.h"
 
 namespace pspslam {
 
@@ -24,70 +27,82 @@ void apply_sensor_override(SystemConfig& config, SensorType sensor,
               to_string(config.camera.type) + " camera (no depth_factor); it has no depth image");
 }
 
+SequenceLayout detect_sequence_layout(const std::filesystem::path& dir) {
+  if (std::filesystem::exists(dir / "times.txt") && std::filesystem::exists(dir / "calib.txt"))
+    return SequenceLayout::kitti;
+  if (std::filesystem::exists(dir / "mav0" / "cam0" / "data.csv") ||
+      std::filesystem::exists(dir / "cam0" / "data.csv"))
+    return SequenceLayout::euroc;
+  return SequenceLayout::tum;
+}
+
 namespace {
 
-// The camera of a rectified stereo layout, from its calibration: pinhole of the rectified left
-// image, no distortion (the frames are rectified, by the dataset or as they load), the baseline.
-void set_rectified_stereo_camera(CameraConfig& camera, cv::Size size, double fx, double fy,
-                                 double cx, double cy, double baseline) {
-  camera.type = SensorType::stereo;
-  camera.pinhole.width = size.width;
-  camera.pinhole.height = size.height;
-  camera.pinhole.fx = fx;
-  camera.pinhole.fy = fy;
-  camera.pinhole.cx = cx;
-  camera.pinhole.cy = cy;
-  camera.pinhole.distortion = {};
-  camera.baseline = baseline;
+// The sensor a self-calibrating layout (KITTI, EuRoC) is read as: `requested` (`--sensor`) when
+// given, else stereo when the right camera's images are there and monocular when they are not.
+// Neither layout has depth images; stereo needs the right camera.
+SensorType layout_sensor(const std::filesystem::path& dir, SequenceLayout layout,
+                         std::optional<SensorType> requested) {
+  const bool kitti = layout == SequenceLayout::kitti;
+  const bool right =
+      kitti ? KittiSequence::has_right_images(dir) : EurocSequence::has_right_camera(dir);
+  if (!requested) return right ? SensorType::stereo : SensorType::monocular;
+  if (*requested == SensorType::rgbd || (*requested == SensorType::stereo && !right)) {
+    throw Error("--sensor " + to_string(*requested) + ": " + dir.string() + " is " +
+                (kitti ? "a KITTI odometry sequence" : "a EuRoC MAV sequence") +
+                (right   ? " (stereo)"
+                 : kitti ? " (monocular: image_0/ without image_1/)"
+                         : " (monocular: cam0 without cam1/data.csv)"));
+  }
+  return *requested;
 }
 
-SequenceSetup open_kitti_with_config(const std::filesystem::path& dir,
-                                     const std::optional<std::filesystem::path>& config_file,
-                                     std::ostream* warnings) {
-  SystemConfig config;
-  std::filesystem::path config_path = dir / "calib.txt";
-  if (config_file) {
-    config = load_config(*config_file);
-    config_path = *config_file;
+std::unique_ptr<const RecordedSequence> open_layout(const std::filesystem::path& dir,
+                                                    SequenceLayout layout,
+                                                    const SequenceOptions& options) {
+  switch (layout) {
+    case SequenceLayout::kitti:
+      return std::make_unique<const KittiSequence>(KittiSequence::open(dir, options));
+    case SequenceLayout::euroc:
+      return std::make_unique<const EurocSequence>(EurocSequence::open(dir, options));
+    case SequenceLayout::tum:
+      break;
   }
-  const KittiCalibration calibration = read_kitti_calibration(dir / "calib.txt");
-  SequenceOptions options;
-  options.warnings = warnings;
-  RgbdSequence sequence = RgbdSequence::open_kitti(dir, options);
-  const InputFrame first = sequence.load(0);
-  CameraConfig& camera = config.camera;
-  if (!config_file) camera.name = "kitti";
-  set_rectified_stereo_camera(camera, first.bgr.size(), calibration.fx, calibration.fy,
-                              calibration.cx, calibration.cy, calibration.baseline);
-  if (!config_file || camera.depth_threshold <= 0.0)
-    camera.depth_threshold = 40.0 * camera.baseline;
-  if (!config_file && sequence.size() > 1) {
-    camera.fps = static_cast<double>(sequence.size() - 1) /
-                 (sequence.timestamp(sequence.size() - 1) - sequence.timestamp(0));
-  }
-  return SequenceSetup{config_path, config, std::move(sequence)};
+  return std::make_unique<const TumSequence>(TumSequence::open(dir, options));
 }
 
-SequenceSetup open_euroc_with_config(const std::filesystem::path& dir,
+// KITTI and EuRoC: the camera is the layout's own calibration (LayoutCamera); the config, when
+// given, supplies the rest.
+SequenceSetup open_calibrated_layout(const std::filesystem::path& dir, SequenceLayout layout,
                                      const std::optional<std::filesystem::path>& config_file,
-                                     std::ostream* warnings) {
+                                     std::ostream* warnings, std::optional<SensorType> sensor) {
+  const bool kitti = layout == SequenceLayout::kitti;
   SystemConfig config;
-  std::filesystem::path config_path = dir / "mav0" / "cam0" / "sensor.yaml";
+  std::filesystem::path config_path =
+      kitti ? dir / "calib.txt" : dir / "mav0" / "cam0" / "sensor.yaml";
   if (config_file) {
     config = load_config(*config_file);
     config_path = *config_file;
   }
   SequenceOptions options;
   options.warnings = warnings;
-  RgbdSequence sequence = RgbdSequence::open_euroc(dir, options);
-  const StereoRectification& rect = *sequence.rectification();
-  const EurocCamera left = read_euroc_camera(sequence.directory() / "cam0" / "sensor.yaml");
+  options.sensor = layout_sensor(dir, layout, sensor);
+  std::unique_ptr<const RecordedSequence> sequence = open_layout(dir, layout, options);
+  const LayoutCamera calibration = *sequence->layout_camera();
   CameraConfig& camera = config.camera;
-  if (!config_file) camera.name = "euroc";
-  set_rectified_stereo_camera(camera, rect.size, rect.fx, rect.fy, rect.cx, rect.cy, rect.baseline);
+  camera.type = sequence->sensor();
+  camera.pinhole.width = calibration.size.width;
+  camera.pinhole.height = calibration.size.height;
+  camera.pinhole.fx = calibration.fx;
+  camera.pinhole.fy = calibration.fy;
+  camera.pinhole.cx = calibration.cx;
+  camera.pinhole.cy = calibration.cy;
+  camera.pinhole.distortion = {};  // the frames are rectified, by the dataset or as they load
+  camera.baseline = calibration.baseline;
   if (!config_file) {
-    camera.depth_threshold = 40.0 * camera.baseline;
-    camera.fps = left.rate_hz;
+    camera.name = to_string(layout);
+    if (sequence->stereo()) camera.depth_threshold = 40.0 * camera.baseline;
+    if (calibration.rate_hz > 0.0) camera.fps = calibration.rate_hz;
   }
   return SequenceSetup{config_path, config, std::move(sequence)};
 }
@@ -100,22 +115,9 @@ SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
   if (!std::filesystem::is_directory(dir)) {
     throw Error(dir.string() + ": sequence directory not found");
   }
-  if (std::filesystem::exists(dir / "times.txt") && std::filesystem::exists(dir / "calib.txt")) {
-    if (sensor && *sensor != SensorType::stereo) {
-      throw Error("--sensor " + to_string(*sensor) + ": " + dir.string() +
-                  " is a KITTI odometry sequence (stereo)");
-    }
-    return open_kitti_with_config(dir, config_file, warnings);
-  }
-  if (std::filesystem::exists(dir / "mav0" / "cam0" / "data.csv") ||
-      (std::filesystem::exists(dir / "cam0" / "data.csv") &&
-       std::filesystem::exists(dir / "cam1" / "data.csv"))) {
-    if (sensor && *sensor != SensorType::stereo) {
-      throw Error("--sensor " + to_string(*sensor) + ": " + dir.string() +
-                  " is a EuRoC MAV sequence (stereo)");
-    }
-    return open_euroc_with_config(dir, config_file, warnings);
-  }
+  const SequenceLayout layout = detect_sequence_layout(dir);
+  if (layout != SequenceLayout::tum)
+    return open_calibrated_layout(dir, layout, config_file, warnings, sensor);
   std::filesystem::path config_path;
   if (config_file) {
     config_path = *config_file;
@@ -129,50 +131,32 @@ SequenceSetup open_sequence_with_config(const std::filesystem::path& dir,
   SystemConfig config = load_config(config_path);
   if (sensor) apply_sensor_override(config, *sensor, config_path);
   SequenceOptions options;
-  options.stereo = config.camera.type == SensorType::stereo;
-  options.colour_only = config.camera.type == SensorType::monocular;
+  options.sensor = config.camera.type;
   options.depth_factor = config.camera.depth_factor;
   options.depth_shift_x = config.camera.depth_shift_x;
   options.depth_shift_y = config.camera.depth_shift_y;
   options.warnings = warnings;
-  return SequenceSetup{config_path, config, RgbdSequence::open(dir, options)};
+  return SequenceSetup{config_path, config, open_layout(dir, layout, options)};
 }
 
 std::string describe_sequence(const SequenceSetup& setup) {
-  const RgbdSequence& s = setup.sequence;
+  const RecordedSequence& s = *setup.sequence;
   std::ostringstream out;
   char line[512];
   out << "sequence:     " << s.directory().string() << "\n";
-  char how[64];
-  if (s.layout() != SequenceLayout::tum) {
-    std::snprintf(how, sizeof(how), "paired as the %s layout lists them",
-                  to_string(s.layout()).c_str());
-  } else if (s.used_associations_file()) {
-    std::snprintf(how, sizeof(how), "in associations.txt");
-  } else {
-    std::snprintf(how, sizeof(how), "associated within %g s", s.options().max_difference);
-  }
-  if (!s.options().colour_only) {
-    std::snprintf(line, sizeof(line),
-                  "frames:       %zu (%zu colour and %zu %s files listed, %s; %zu listed files "
-                  "missing, %zu frames skipped)\n",
-                  s.size(), s.listed_rgb(), s.listed_depth(), s.stereo() ? "right" : "depth", how,
-                  s.missing_files(), s.skipped_frames());
-  } else {
-    std::snprintf(line, sizeof(line),
-                  "frames:       %zu (%zu colour files listed in rgb.txt, colour only; %zu listed "
-                  "files missing, %zu frames skipped)\n",
-                  s.size(), s.listed_rgb(), s.missing_files(), s.skipped_frames());
-  }
+  std::snprintf(line, sizeof(line),
+                "frames:       %zu (%s; %zu listed files missing, %zu frames skipped)\n", s.size(),
+                s.listing().c_str(), s.missing_files(), s.skipped_frames());
   out << line;
   std::snprintf(line, sizeof(line), "time span:    %.3f s (%.5f .. %.5f)\n",
                 s.timestamp(s.size() - 1) - s.timestamp(0), s.timestamp(0),
                 s.timestamp(s.size() - 1));
   out << line;
   if (s.ground_truth()) {
-    out << "ground truth: yes (" << s.ground_truth()->size() << " poses in groundtruth.txt)\n";
+    out << "ground truth: yes (" << s.ground_truth()->size() << " poses in "
+        << s.ground_truth_file().string() << ")\n";
   } else {
-    out << "ground truth: no (no groundtruth.txt)\n";
+    out << "ground truth: no (no " << s.ground_truth_file().string() << ")\n";
   }
   const CameraConfig& camera = setup.config.camera;
   if (camera.type == SensorType::monocular) {

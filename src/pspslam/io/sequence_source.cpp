@@ -23,25 +23,25 @@ size_t frame_bytes(const InputFrame& frame) {
 
 SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool paced, Preload preload)
     : setup_(std::move(setup)),
-      frames_(max_frames == 0 ? setup_.sequence.size()
-                              : std::min(setup_.sequence.size(), max_frames)),
+      frames_(max_frames == 0 ? setup_.sequence->size()
+                              : std::min(setup_.sequence->size(), max_frames)),
       paced_(paced) {
   if (preload == Preload::on && !paced_)
     throw Error("--preload: only a --realtime run replays at the camera's rate");
   if (paced_ && preload != Preload::off && frames_ > 0) {
-    InputFrame first = setup_.sequence.load(0);
+    InputFrame first = setup_.sequence->load(0);
     const double need = static_cast<double>(frame_bytes(first)) * static_cast<double>(frames_);
     const size_t limit = preload == Preload::on ? kPreloadLimitBytes : kAutoPreloadBytes;
     if (need <= static_cast<double>(limit)) {
       preloaded_.reserve(frames_);
       preloaded_.push_back(std::move(first));
       for (size_t index = 1; index < frames_; ++index)
-        preloaded_.push_back(setup_.sequence.load(index));
+        preloaded_.push_back(setup_.sequence->load(index));
       preloaded_bytes_ = static_cast<size_t>(need);
     } else if (preload == Preload::on) {
       std::ostringstream message;
       message << std::fixed << std::setprecision(1) << "--preload: " << frames_ << " frames of "
-              << setup_.sequence.directory().string() << " decode to "
+              << setup_.sequence->directory().string() << " decode to "
               << need / static_cast<double>(size_t{1} << 30) << " GiB, more than the "
               << (kPreloadLimitBytes >> 30)
               << " GiB limit; run with --preload off (frames are then decoded ahead on a "
@@ -59,7 +59,7 @@ SequenceSource::~SequenceSource() {
 }
 
 void SequenceSource::read_paced(const std::stop_token& stop) {
-  const RgbdSequence& sequence = setup_.sequence;
+  const RecordedSequence& sequence = *setup_.sequence;
   Clock::time_point start;
   {
     std::unique_lock lock(start_mutex_);
@@ -104,7 +104,7 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
 std::optional<InputFrame> SequenceSource::next() {
   if (!paced_) {
     if (next_index_ >= frames_) return std::nullopt;
-    return setup_.sequence.load(next_index_++);
+    return setup_.sequence->load(next_index_++);
   }
   {
     std::lock_guard lock(start_mutex_);

@@ -47,10 +47,10 @@ class SequenceSource final : public FrameSource {
 
   std::optional<InputFrame> next() override;
   std::optional<size_t> frame_count() const override { return frames_; }
-  std::string name() const override { return setup_.sequence.directory().string(); }
+  std::string name() const override { return setup_.sequence->directory().string(); }
   std::string describe() const override;
   const std::optional<Trajectory>& ground_truth() const override {
-    return setup_.sequence.ground_truth();
+    return setup_.sequence->ground_truth();
   }
   FrameSourceStats stats() const override {
     FrameSourceStats stats;

@@ -4,7 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pspslam/core/error.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/image_files.h"
 
 namespace pspslam {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/feature/orb_extractor.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/loop/loop_closing.h"
 #include "pspslam/map/frame.h"
 #include "pspslam/mapping/local_mapping_options.h"

@@ -10,7 +10,7 @@
 #include "pspslam/config/config.h"
 #include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/system/system_options.h"
 #include "pspslam/tracking/tracker.h"
 

@@ -18,7 +18,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
 #include "pspslam/eval/ate.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/input_frame.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"

@@ -23,14 +23,14 @@ int main(int argc, char** argv) {
     options.back_end_wait = pspslam::BackEndWait::whole_back_end;
     pspslam::System system(setup.config, options);
     size_t tracked = 0, masked = 0;
-    for (size_t i = 0; i < setup.sequence.size(); ++i) {
-      const pspslam::FrameReport report = system.process(setup.sequence.load(i));
+    for (size_t i = 0; i < setup.sequence->size(); ++i) {
+      const pspslam::FrameReport report = system.process(setup.sequence->load(i));
       if (report.tracking.T_world_camera) ++tracked;
       const cv::Mat mask = system.last_dynamic_mask();
       if (!mask.empty() && cv::countNonZero(mask) > 0) ++masked;
     }
     system.shutdown();
-    std::cout << "frames " << setup.sequence.size() << " tracked " << tracked << " masked_frames "
+    std::cout << "frames " << setup.sequence->size() << " tracked " << tracked << " masked_frames "
               << masked << " model " << options.dynamic.model.string() << "\n";
   } catch (const std::exception& e) {
     std::cerr << "consumer: " << e.what() << "\n";

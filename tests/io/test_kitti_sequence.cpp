@@ -5,9 +5,10 @@
 #include <sstream>
 
 #include "pspslam/core/error.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/kitti_sequence.h"
 #include "pspslam/io/sequence_setup.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/io/tum_sequence.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -61,7 +62,7 @@ SequenceOptions quiet() {
 
 TEST(KittiSequence, ReadsPairsTimesCalibrationAndPoses) {
   const fs::path dir = make_kitti("kitti_ok");
-  const RgbdSequence sequence = RgbdSequence::open_kitti(dir, quiet());
+  const KittiSequence sequence = KittiSequence::open(dir, quiet());
   ASSERT_EQ(sequence.size(), 3u);
   EXPECT_EQ(sequence.layout(), SequenceLayout::kitti);
   EXPECT_TRUE(sequence.stereo());
@@ -104,7 +105,7 @@ TEST(KittiSequence, MissingImagesAreCountedOnceAndTheirFramesSkipped) {
   SequenceOptions options;
   options.warnings = &warnings;
   fs::remove(dir / "poses.txt");
-  const RgbdSequence sequence = RgbdSequence::open_kitti(dir, options);
+  const KittiSequence sequence = KittiSequence::open(dir, options);
   EXPECT_EQ(sequence.size(), 2u);
   EXPECT_EQ(sequence.missing_files(), 3u);
   EXPECT_EQ(sequence.skipped_frames(), 2u);
@@ -116,23 +117,23 @@ TEST(KittiSequence, MissingImagesAreCountedOnceAndTheirFramesSkipped) {
 TEST(KittiSequence, MalformedFilesNameFileAndLine) {
   const fs::path dir = make_kitti("kitti_bad");
   write_text(dir / "times.txt", "0.0\n0.1 x\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "times.txt").string() + ":2: expected one timestamp, got 2 fields");
   write_text(dir / "times.txt", "0.0\n0.1\n0.1\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "times.txt").string() + ":3: timestamp 0.1 does not increase");
   write_text(dir / "times.txt", "0.0\nabc\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "times.txt").string() + ":2: timestamp 'abc' is not a number");
   write_text(dir / "times.txt", "0.0\n0.1\n0.2\n");
   write_text(dir / "poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "poses.txt").string() + ":2: expected 12 numbers (3x4 pose, row-major), got 11");
   write_text(dir / "poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n2 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "poses.txt").string() + ":2: the rotation is not orthonormal");
   write_text(dir / "poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(dir, quiet()); }),
             (dir / "poses.txt").string() + ": 1 poses for 3 timestamps in times.txt");
   fs::remove(dir / "poses.txt");
 
@@ -156,10 +157,10 @@ TEST(KittiSequence, MalformedFilesNameFileAndLine) {
                 ":2: P1 fx 501.000000 differs from P0's 500.000000: not a rectified pair");
 
   const fs::path empty = testing::make_temp_dir("kitti_empty");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_kitti(empty, quiet()); }),
+  EXPECT_EQ(error_of([&] { KittiSequence::open(empty, quiet()); }),
             empty.string() +
-                ": no times.txt (a KITTI odometry sequence needs times.txt, calib.txt, image_0/ "
-                "and image_1/)");
+                ": no times.txt (a KITTI odometry sequence needs times.txt, calib.txt and "
+                "image_0/, and image_1/ for stereo)");
 }
 
 TEST(KittiTrajectory, WriteReadRoundTrip) {
@@ -202,13 +203,13 @@ TEST(StereoTumSequence, ReadsLeftAndRightLists) {
   }
   write_text(dir / "rgb.txt", rgb);
   SequenceOptions options = quiet();
-  options.stereo = true;
-  EXPECT_EQ(error_of([&] { RgbdSequence::open(dir, options); }),
+  options.sensor = SensorType::stereo;
+  EXPECT_EQ(error_of([&] { TumSequence::open(dir, options); }),
             dir.string() +
                 ": no right.txt (a stereo sequence in TUM layout needs rgb.txt and "
                 "right.txt)");
   write_text(dir / "right.txt", right);
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   ASSERT_EQ(sequence.size(), 2u);
   const InputFrame frame = sequence.load(1);
   EXPECT_EQ(frame.right.at<uint8_t>(0, 0), 8);

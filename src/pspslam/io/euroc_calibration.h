@@ -44,4 +44,17 @@ struct StereoRectification {
                cv::Mat& right_out) const;
 };
 
+// The undistortion of one camera on its own (a monocular run): remap tables onto a pinhole
+// camera without distortion that keeps the camera's orientation, its matrix chosen so that every
+// pixel of the result is seen (cv::getOptimalNewCameraMatrix, alpha 0, as the pair's
+// rectification keeps only valid pixels). A camera without distortion is kept as it is.
+struct Undistortion {
+  cv::Mat map_x, map_y;  // empty when there is no distortion to undo
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  cv::Size size;
+
+  static Undistortion compute(const EurocCamera& camera);
+  void undistort(const cv::Mat& image, cv::Mat& out) const;
+};
+
 }  // namespace pspslam

@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "pspslam/core/error.h"
-#include "pspslam/io/euroc.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/euroc_calibration.h"
+#include "pspslam/io/euroc_sequence.h"
 #include "pspslam/io/sequence_setup.h"
 #include "support/test_support.h"
 
@@ -93,7 +93,7 @@ SequenceOptions quiet() {
 TEST(EurocSequence, ReadsRectifiesAndMovesTheGroundTruthOntoTheCamera) {
   const fs::path dir = make_euroc("euroc_ok");
   const SequenceSetup setup = open_sequence_with_config(dir, std::nullopt, nullptr);
-  const RgbdSequence& sequence = setup.sequence;
+  const RecordedSequence& sequence = *setup.sequence;
   ASSERT_EQ(sequence.size(), 3u);
   EXPECT_EQ(sequence.layout(), SequenceLayout::euroc);
   EXPECT_NEAR(sequence.timestamp(1), 1403636579.813555584, 1e-6);
@@ -150,15 +150,51 @@ TEST(EurocSequence, RectifiedRowsAgreeAndDisparityMatchesDepth) {
   }
 }
 
+// cam0 alone (a monocular run): a dot at the projection of a known 3D point in the raw,
+// distorted image lands, once the frame is loaded, at its pinhole projection by the camera the
+// sequence reports; the ground truth is cam0's.
+TEST(EurocSequence, Cam0AloneIsUndistortedOntoItsReportedCamera) {
+  const fs::path dir = make_euroc("euroc_mono");
+  const fs::path mav = dir / "mav0";
+  fs::remove_all(mav / "cam1");
+  const EurocCamera left = read_euroc_camera(mav / "cam0" / "sensor.yaml");
+  const Eigen::Vector3d X(0.3, -0.2, 1.5);
+  std::vector<cv::Point2d> pixels;
+  cv::projectPoints(std::vector<cv::Point3d>{{X.x(), X.y(), X.z()}}, cv::Vec3d(0, 0, 0),
+                    cv::Vec3d(0, 0, 0), cv::Mat(left.K), left.distortion, pixels);
+  cv::Mat raw(kHeight, kWidth, CV_8UC1, cv::Scalar(0));
+  cv::circle(raw, cv::Point(cvRound(pixels[0].x * 16), cvRound(pixels[0].y * 16)), 3 * 16,
+             cv::Scalar(255), cv::FILLED, cv::LINE_AA, 4);
+  const std::string first = std::to_string(1403636579763555584LL) + ".png";
+  cv::imwrite((mav / "cam0" / "data" / first).string(), raw);
+
+  const SequenceSetup setup = open_sequence_with_config(dir, std::nullopt, nullptr);
+  const RecordedSequence& sequence = *setup.sequence;
+  EXPECT_EQ(sequence.sensor(), SensorType::monocular);
+  ASSERT_EQ(sequence.size(), 3u);
+  const CameraConfig& camera = setup.config.camera;
+  EXPECT_EQ(camera.type, SensorType::monocular);
+  EXPECT_FALSE(camera.pinhole.has_distortion());
+  EXPECT_EQ(camera.pinhole.width, kWidth);
+  const cv::Mat gray = sequence.load(0).gray;
+  const cv::Moments m = cv::moments(gray);
+  ASSERT_GT(m.m00, 0.0);
+  EXPECT_NEAR(m.m10 / m.m00, camera.pinhole.fx * X.x() / X.z() + camera.pinhole.cx, 0.3);
+  EXPECT_NEAR(m.m01 / m.m00, camera.pinhole.fy * X.y() / X.z() + camera.pinhole.cy, 0.3);
+  ASSERT_TRUE(sequence.ground_truth());
+  EXPECT_TRUE(sequence.ground_truth()->at(2).T_world_camera.isApprox(
+      Pose(Eigen::Translation3d(2, 2, 3)), 1e-9));
+}
+
 TEST(EurocSequence, MalformedFilesNameFileLineAndKey) {
   const fs::path dir = make_euroc("euroc_bad");
   const fs::path mav = dir / "mav0";
   write_text(mav / "cam0" / "data.csv", "#timestamp [ns],filename\n1,1.png\n2\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_euroc(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { EurocSequence::open(dir, quiet()); }),
             (mav / "cam0" / "data.csv").string() +
                 ":3: expected 'timestamp [ns],filename', got 1 fields");
   write_text(mav / "cam0" / "data.csv", "#timestamp [ns],filename\nx,1.png\n");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_euroc(dir, quiet()); }),
+  EXPECT_EQ(error_of([&] { EurocSequence::open(dir, quiet()); }),
             (mav / "cam0" / "data.csv").string() + ":2: timestamp 'x' is not a number");
 
   std::string yaml = sensor_yaml(Pose::Identity(), kDistortion);
@@ -176,21 +212,21 @@ TEST(EurocSequence, MalformedFilesNameFileLineAndKey) {
   above.translation() = Eigen::Vector3d(0.0, 0.11, 0.0);
   write_text(mav / "cam1" / "sensor.yaml", sensor_yaml(above, kDistortion));
   EXPECT_NE(error_of([&] {
-              RgbdSequence::open_euroc(dir, quiet());
+              EurocSequence::open(dir, quiet());
             }).find("the right camera is above or below the left one (a vertical pair)"),
             std::string::npos);
 
   write_text(mav / "cam1" / "sensor.yaml", sensor_yaml(Pose::Identity(), kDistortion));
   EXPECT_NE(error_of([&] {
-              RgbdSequence::open_euroc(dir, quiet());
+              EurocSequence::open(dir, quiet());
             }).find("the two cameras are at the same place (T_BS): no stereo baseline"),
             std::string::npos);
 
   const fs::path empty = testing::make_temp_dir("euroc_empty");
-  EXPECT_EQ(error_of([&] { RgbdSequence::open_euroc(empty, quiet()); }),
+  EXPECT_EQ(error_of([&] { EurocSequence::open(empty, quiet()); }),
             empty.string() +
-                ": no mav0/cam0/data.csv (an EuRoC MAV sequence needs mav0/cam0 and mav0/cam1, "
-                "each with data.csv, data/ and sensor.yaml)");
+                ": no mav0/cam0/data.csv (an EuRoC MAV sequence needs mav0/cam0, and mav0/cam1 "
+                "for stereo, each with data.csv, data/ and sensor.yaml)");
 }
 
 TEST(EurocSequence, MissingImagesAreCountedOnce) {
@@ -200,7 +236,7 @@ TEST(EurocSequence, MissingImagesAreCountedOnce) {
   std::ostringstream warnings;
   SequenceOptions options;
   options.warnings = &warnings;
-  const RgbdSequence sequence = RgbdSequence::open_euroc(dir, options);
+  const EurocSequence sequence = EurocSequence::open(dir, options);
   EXPECT_EQ(sequence.size(), 3u);
   EXPECT_EQ(sequence.missing_files(), 1u);
   EXPECT_NE(warnings.str().find("1 listed files are missing; skipped 1 frames (first: "

@@ -5,8 +5,9 @@
 #include <sstream>
 
 #include "pspslam/core/error.h"
-#include "pspslam/io/rgbd_sequence.h"
+#include "pspslam/io/image_files.h"
 #include "pspslam/io/sequence_setup.h"
+#include "pspslam/io/tum_sequence.h"
 #include "support/test_support.h"
 
 namespace pspslam {
@@ -42,7 +43,7 @@ std::string open_error(const std::filesystem::path& dir) {
   try {
     SequenceOptions options;
     options.warnings = nullptr;
-    RgbdSequence::open(dir, options);
+    TumSequence::open(dir, options);
   } catch (const Error& e) {
     return e.what();
   }
@@ -52,7 +53,7 @@ std::string open_error(const std::filesystem::path& dir) {
 std::string load_error(const std::filesystem::path& dir, size_t index) {
   SequenceOptions options;
   options.warnings = nullptr;
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   try {
     sequence.load(index);
   } catch (const Error& e) {
@@ -61,12 +62,12 @@ std::string load_error(const std::filesystem::path& dir, size_t index) {
   return "(no error)";
 }
 
-TEST(RgbdSequence, AssociatesAndLoadsFrames) {
+TEST(TumSequence, AssociatesAndLoadsFrames) {
   const auto dir = make_sequence("seq");
   std::ostringstream warnings;
   SequenceOptions options;
   options.warnings = &warnings;
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   EXPECT_TRUE(warnings.str().empty());
   ASSERT_EQ(sequence.size(), 4u);
   EXPECT_EQ(sequence.listed_rgb(), 4u);
@@ -86,17 +87,17 @@ TEST(RgbdSequence, AssociatesAndLoadsFrames) {
   EXPECT_FLOAT_EQ(frame.depth.at<float>(0, 0), 0.0f);  // no reading stays 0
 }
 
-TEST(RgbdSequence, DepthFactorIsApplied) {
+TEST(TumSequence, DepthFactorIsApplied) {
   const auto dir = make_sequence("seq");
   SequenceOptions options;
   options.depth_factor = 1000.0;
-  const InputFrame frame = RgbdSequence::open(dir, options).load(0);
+  const InputFrame frame = TumSequence::open(dir, options).load(0);
   EXPECT_FLOAT_EQ(frame.depth.at<float>(3, 3), 5.0f);
 }
 
 // The registration shift reads depth pixel (u + dx, v + dy) for colour pixel (u, v); what is
 // shifted in from beyond the border has no reading.
-TEST(RgbdSequence, DepthRegistrationShiftMovesTheDepthImage) {
+TEST(TumSequence, DepthRegistrationShiftMovesTheDepthImage) {
   const auto dir = testing::make_temp_dir("depth_shift");
   cv::Mat raw(6, 8, CV_16UC1);
   for (int v = 0; v < raw.rows; ++v)
@@ -116,19 +117,19 @@ TEST(RgbdSequence, DepthRegistrationShiftMovesTheDepthImage) {
   SequenceOptions options;
   options.warnings = nullptr;
   options.depth_shift_y = 1;
-  const InputFrame frame = RgbdSequence::open(sequence_dir, options).load(0);
+  const InputFrame frame = TumSequence::open(sequence_dir, options).load(0);
   EXPECT_FLOAT_EQ(frame.depth.at<float>(0, 1), 1.0f);  // row 1 of the image
   EXPECT_FLOAT_EQ(frame.depth.at<float>(5, 1), 0.0f);  // shifted in from below the border
 }
 
-TEST(RgbdSequence, MissingFilesSkipFramesWithOneWarning) {
+TEST(TumSequence, MissingFilesSkipFramesWithOneWarning) {
   const auto dir = make_sequence("seq");
   std::filesystem::remove(dir / "depth/10.1050.png");
   std::filesystem::remove(dir / "rgb/10.3000.png");
   std::ostringstream warnings;
   SequenceOptions options;
   options.warnings = &warnings;
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   EXPECT_EQ(warnings.str(), "warning: " + dir.string() +
                                 ": 2 listed files are missing; skipped 2 frames (first: "
                                 "rgb/10.3000.png)\n");
@@ -143,7 +144,7 @@ TEST(RgbdSequence, MissingFilesSkipFramesWithOneWarning) {
 
 // Found by fuzz/fuzz_sequence_lists: a listed file name too long for the file system made
 // std::filesystem::exists throw (exit 3); it is a missing file like any other.
-TEST(RgbdSequence, UnlookupableFileNameIsAMissingFile) {
+TEST(TumSequence, UnlookupableFileNameIsAMissingFile) {
   const auto dir = testing::make_temp_dir("sequence_long_name");
   const std::string long_name(5000, 'c');
   std::ofstream(dir / "rgb.txt") << "1.0 " << long_name << "\n";
@@ -153,7 +154,7 @@ TEST(RgbdSequence, UnlookupableFileNameIsAMissingFile) {
                                  "associated within 0.020000 s with both files present");
 }
 
-TEST(RgbdSequence, MalformedListLinesNameFileAndLine) {
+TEST(TumSequence, MalformedListLinesNameFileAndLine) {
   const auto dir = make_sequence("seq");
   write_text(dir / "rgb.txt", "# header\n10.0000 rgb/10.0000.png\n10.1000\n");
   EXPECT_EQ(open_error(dir),
@@ -169,19 +170,19 @@ TEST(RgbdSequence, MalformedListLinesNameFileAndLine) {
   EXPECT_EQ(open_error(dir), (dir / "depth.txt").string() + ":2: timestamp 10.005 repeats line 1");
 }
 
-TEST(RgbdSequence, MalformedGroundTruthIsAnError) {
+TEST(TumSequence, MalformedGroundTruthIsAnError) {
   const auto dir = make_sequence("seq");
   write_text(dir / "groundtruth.txt", "# gt\n10.0 0 0 0 0 0 0 1\n10.1 0 0 0 0 0 0\n");
   EXPECT_EQ(open_error(dir), (dir / "groundtruth.txt").string() +
                                  ":3: expected 8 fields 'timestamp tx ty tz qx qy qz qw', got 7");
   write_text(dir / "groundtruth.txt", "10.0 0 0 0 0 0 0 1\n10.1 1 0 0 0 0 0 1\n");
   SequenceOptions options;
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   ASSERT_TRUE(sequence.ground_truth().has_value());
   EXPECT_EQ(sequence.ground_truth()->size(), 2u);
 }
 
-TEST(RgbdSequence, MissingDirectoryAndLists) {
+TEST(TumSequence, MissingDirectoryAndLists) {
   const auto dir = make_sequence("seq");
   EXPECT_EQ(open_error(dir / "nope"), (dir / "nope").string() + ": sequence directory not found");
   std::filesystem::remove(dir / "depth.txt");
@@ -191,7 +192,7 @@ TEST(RgbdSequence, MissingDirectoryAndLists) {
                 "associations.txt)");
 }
 
-TEST(RgbdSequence, NothingAssociated) {
+TEST(TumSequence, NothingAssociated) {
   const auto dir = make_sequence("seq");
   write_text(dir / "depth.txt", "20.0 depth/10.0050.png\n");
   EXPECT_EQ(open_error(dir), dir.string() +
@@ -199,13 +200,13 @@ TEST(RgbdSequence, NothingAssociated) {
                                  "associated within 0.020000 s with both files present");
 }
 
-TEST(RgbdSequence, AssociationsFileIsUsedAsGiven) {
+TEST(TumSequence, AssociationsFileIsUsedAsGiven) {
   const auto dir = make_sequence("seq");
   // Pairs that associate.py would not make (0.105 s apart): the file is taken as given.
   write_text(dir / "associations.txt",
              "# t_rgb rgb t_depth depth\n10.0 rgb/10.0000.png 10.105 depth/10.1050.png\n"
              "10.2 rgb/10.2000.png 10.005 depth/10.0050.png\n");
-  const RgbdSequence sequence = RgbdSequence::open(dir);
+  const TumSequence sequence = TumSequence::open(dir);
   EXPECT_TRUE(sequence.used_associations_file());
   ASSERT_EQ(sequence.size(), 2u);
   EXPECT_EQ(sequence.files(1).depth_file, "depth/10.0050.png");
@@ -215,7 +216,7 @@ TEST(RgbdSequence, AssociationsFileIsUsedAsGiven) {
                                  ":1: expected 't_rgb rgb_file t_depth depth_file', got 3 fields");
 }
 
-TEST(RgbdSequence, EightBitDepthIsAnError) {
+TEST(TumSequence, EightBitDepthIsAnError) {
   const auto dir = make_sequence("seq");
   cv::imwrite((dir / "depth/10.0050.png").string(), cv::Mat(6, 8, CV_8UC1, cv::Scalar(3)));
   EXPECT_EQ(load_error(dir, 0), (dir / "depth/10.0050.png").string() +
@@ -227,7 +228,7 @@ TEST(RgbdSequence, EightBitDepthIsAnError) {
                                     "channels)");
 }
 
-TEST(RgbdSequence, EmptyDepthFileIsAnError) {
+TEST(TumSequence, EmptyDepthFileIsAnError) {
   const auto dir = make_sequence("seq");
   write_text(dir / "depth/10.0050.png", "");
   EXPECT_EQ(load_error(dir, 0), (dir / "depth/10.0050.png").string() +
@@ -237,7 +238,7 @@ TEST(RgbdSequence, EmptyDepthFileIsAnError) {
                                     ": cannot read colour image (missing, empty or not an image)");
 }
 
-TEST(RgbdSequence, ColourAndDepthOfDifferentSize) {
+TEST(TumSequence, ColourAndDepthOfDifferentSize) {
   const auto dir = make_sequence("seq");
   cv::imwrite((dir / "depth/10.0050.png").string(), cv::Mat(3, 4, CV_16UC1, cv::Scalar(1)));
   EXPECT_EQ(load_error(dir, 0), (dir / "rgb/10.0000.png").string() + " is 8x6 but " +
@@ -260,8 +261,8 @@ TEST(SequenceSetup, UsesSequenceConfigOrAsksForOne) {
              "  distortion: [0, 0, 0, 0]\n  fps: 10\n  depth_factor: 2500\n  depth_threshold: 3\n");
   const SequenceSetup setup = open_sequence_with_config(dir, std::nullopt, nullptr);
   EXPECT_EQ(setup.config_file, dir / "config.yaml");
-  EXPECT_EQ(setup.sequence.config_path(), dir / "config.yaml");
-  EXPECT_FLOAT_EQ(setup.sequence.load(0).depth.at<float>(1, 1), 2.0f);  // 5000 / 2500
+  EXPECT_EQ(setup.sequence->config_path(), dir / "config.yaml");
+  EXPECT_FLOAT_EQ(setup.sequence->load(0).depth.at<float>(1, 1), 2.0f);  // 5000 / 2500
   EXPECT_EQ(describe_sequence(setup),
             "sequence:     " + dir.string() +
                 "\n"
@@ -279,7 +280,7 @@ TEST(BonnCrowdDev, LoaderOnRealData) {
   std::ostringstream warnings;
   SequenceOptions options;
   options.warnings = &warnings;
-  const RgbdSequence sequence = RgbdSequence::open(dir, options);
+  const TumSequence sequence = TumSequence::open(dir, options);
   EXPECT_EQ(sequence.listed_rgb(), 400u);
   EXPECT_EQ(sequence.listed_depth(), 403u);
   // depth.txt lists two depth files that do not exist (the README's third, 1548339834.30352,

@@ -1,4 +1,4 @@
-#include "pspslam/io/euroc.h"
+#include "pspslam/io/euroc_calibration.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -148,6 +148,36 @@ void StereoRectification::rectify(const cv::Mat& left, const cv::Mat& right, cv:
                                   cv::Mat& right_out) const {
   cv::remap(left, left_out, left_map_x, left_map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   cv::remap(right, right_out, right_map_x, right_map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+}
+
+Undistortion Undistortion::compute(const EurocCamera& camera) {
+  Undistortion result;
+  result.size = cv::Size(camera.width, camera.height);
+  if (camera.distortion == cv::Vec4d::all(0.0)) {
+    // Nothing to undo: the camera stays as it is and its images are used as stored.
+    result.fx = camera.K(0, 0);
+    result.fy = camera.K(1, 1);
+    result.cx = camera.K(0, 2);
+    result.cy = camera.K(1, 2);
+    return result;
+  }
+  const cv::Matx33d K =
+      cv::getOptimalNewCameraMatrix(camera.K, camera.distortion, result.size, 0.0, result.size);
+  result.fx = K(0, 0);
+  result.fy = K(1, 1);
+  result.cx = K(0, 2);
+  result.cy = K(1, 2);
+  cv::initUndistortRectifyMap(camera.K, camera.distortion, cv::Matx33d::eye(), K, result.size,
+                              CV_32FC1, result.map_x, result.map_y);
+  return result;
+}
+
+void Undistortion::undistort(const cv::Mat& image, cv::Mat& out) const {
+  if (map_x.empty()) {
+    out = image;
+    return;
+  }
+  cv::remap(image, out, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
 }
 
 }  // namespace pspslam

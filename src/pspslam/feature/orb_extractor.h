@@ -5,10 +5,10 @@
 #include <array>
 #include <vector>
 
-#include "pspslam/feature/orb_config.h"
 #include "pspslam/feature/brief_pattern.h"
 #include "pspslam/feature/hamming.h"
 #include "pspslam/feature/keypoint_distribution.h"
+#include "pspslam/feature/orb_config.h"
 
 namespace pspslam {
 

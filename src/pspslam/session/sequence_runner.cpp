@@ -54,6 +54,7 @@ RunInput open_sequence_input(const RunOptions& options) {
   SequenceSetup setup = open_sequence_with_config(
       options.sequence, options.config,
       spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr, options.sensor);
+  check_config_sections(setup.config);  // before a preload decodes every frame
   RunInput input{setup.config_file, setup.config, nullptr};
   input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
                                                   options.system.dynamic.realtime, options.preload);

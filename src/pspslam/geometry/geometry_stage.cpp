@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <functional>
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
@@ -22,11 +22,6 @@ struct Stopwatch {
   std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
   double cpu = thread_cpu_ms();
 
-  static double thread_cpu_ms() {
-    timespec now{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-    return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
-  }
   double wall_ms() const { return milliseconds_since(wall); }
   double cpu_ms() const { return thread_cpu_ms() - cpu; }
 };

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -13,6 +12,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
 #include "pspslam/core/progress.h"
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/rgbd_sequence.h"
 #include "pspslam/io/sequence_source.h"
@@ -24,12 +24,6 @@
 
 namespace pspslam {
 namespace {
-
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 
 // --export-map / --export-dense, after shutdown (local mapping has refined the poses).
 void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, const Map& map,

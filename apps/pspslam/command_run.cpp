@@ -190,8 +190,10 @@ void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
   }
 }
 
-int run_slam(const RunFlags& flags, const GlobalOptions& global) {
-  use_single_threaded_blas();  // in every run: its calls are small, its spinning workers are not
+namespace {
+
+// The run's inputs, outputs and limits.
+RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   RunOptions options;
   options.sequence = flags.sequence;
   if (!flags.config.empty()) options.config = flags.config;
@@ -211,19 +213,12 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   options.outputs.overlays = flags.save_overlays;
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
+  return options;
+}
 
-  const RunSettings settings = run_settings(flags);
-  options.system = system_options(settings);
-  SystemOptions& system = options.system;
-  // OpenCV's pool is process-wide: with one thread the network runs on the (lowered) semantic
-  // thread alone instead of borrowing workers that compete with tracking at full priority.
-  if (flags.opencv_threads >= 0)
-    cv::setNumThreads(flags.opencv_threads);
-  else if (settings.live())
-    cv::setNumThreads(1);
-  set_cli_only_options(flags, system);
-
-  // A live camera, or the sequence folder (opened by the runner).
+// A live camera or a video with its config; none for a sequence folder (opened by the runner).
+std::optional<RunInput> open_camera_input(const RunFlags& flags,
+                                          const std::optional<SensorType>& sensor) {
   std::optional<RunInput> camera;
   if (!flags.camera.empty()) {
     const CameraSpec spec = parse_camera_spec(flags.camera);
@@ -231,7 +226,7 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     camera->config_file =
         flags.config.empty() ? camera_config_preset(spec) : std::filesystem::path(flags.config);
     camera->config = load_config(camera->config_file);
-    if (options.sensor) apply_sensor_override(camera->config, *options.sensor, camera->config_file);
+    if (sensor) apply_sensor_override(camera->config, *sensor, camera->config_file);
     camera->source = open_camera(spec);
   }
   if (!flags.video.empty()) {
@@ -241,36 +236,35 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     apply_sensor_override(camera->config, SensorType::monocular, camera->config_file);
     camera->source = open_video(flags.video, camera->config.camera.fps);
   }
-  // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
-  // second of frames, so a live run without --realtime waits for local mapping only.
-  if (!flags.realtime && camera && camera->source->live())
-    system.back_end_wait = BackEndWait::local_mapping;
-  // The viewer binds its address before the model and the sequence load, so a port in use is
-  // told at once; it outlives the runner, which only points to it.
-  std::unique_ptr<LiveViewer> viewer;
-  if (!flags.viewer.empty()) {
-    LiveViewerOptions live;
-    live.endpoint = flags.viewer;
-    live.web_root = data_dir() / "web";
-    live.interval = std::chrono::milliseconds(flags.viewer_interval_ms);
-    live.start_paused = flags.viewer_paused;
-    live.realtime = flags.realtime;
-    live.classes = overlay_classes(system.dynamic);
-    live.title = !flags.video.empty()   ? "video " + flags.video
-                 : flags.camera.empty() ? flags.sequence
-                                        : "camera " + flags.camera;
-    if (!flags.sequence.empty() &&
-        std::filesystem::is_regular_file(std::filesystem::path(flags.sequence) / "groundtruth.txt"))
-      live.ground_truth = std::filesystem::path(flags.sequence) / "groundtruth.txt";
-    viewer = std::make_unique<LiveViewer>(std::move(live));
-    std::cout << "viewer:       " << viewer->url() << "  (live while the run goes"
-              << (flags.viewer_paused ? "; held at the first frame until resume or step" : "")
-              << ")" << std::endl;
-  }
-  SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
-                                 : SequenceRunner(std::move(options), std::cout);
-  runner.watch(viewer.get());
-  switch (runner.run()) {
+  return camera;
+}
+
+// The viewer binds its address before the model and the sequence load, so a port in use is
+// told at once; it outlives the runner, which only points to it.
+std::unique_ptr<LiveViewer> start_viewer(const RunFlags& flags, const SystemOptions& system) {
+  if (flags.viewer.empty()) return nullptr;
+  LiveViewerOptions live;
+  live.endpoint = flags.viewer;
+  live.web_root = data_dir() / "web";
+  live.interval = std::chrono::milliseconds(flags.viewer_interval_ms);
+  live.start_paused = flags.viewer_paused;
+  live.realtime = flags.realtime;
+  live.classes = overlay_classes(system.dynamic);
+  live.title = !flags.video.empty()   ? "video " + flags.video
+               : flags.camera.empty() ? flags.sequence
+                                      : "camera " + flags.camera;
+  if (!flags.sequence.empty() &&
+      std::filesystem::is_regular_file(std::filesystem::path(flags.sequence) / "groundtruth.txt"))
+    live.ground_truth = std::filesystem::path(flags.sequence) / "groundtruth.txt";
+  auto viewer = std::make_unique<LiveViewer>(std::move(live));
+  std::cout << "viewer:       " << viewer->url() << "  (live while the run goes"
+            << (flags.viewer_paused ? "; held at the first frame until resume or step" : "") << ")"
+            << std::endl;
+  return viewer;
+}
+
+int exit_status(RunOutcome outcome) {
+  switch (outcome) {
     case RunOutcome::disconnected:
       return kCameraLostExit;
     case RunOutcome::interrupted:
@@ -283,15 +277,39 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   return 0;
 }
 
-Command add_run_command(CLI::App& root) {
-  CLI::App* app = root.add_subcommand(
-      "run",
-      "run SLAM on an RGB-D sequence and write the trajectory.\n"
-      "Reads a sequence in TUM layout (rgb.txt, depth.txt or associations.txt, optional "
-      "groundtruth.txt)\nand writes OUT/trajectory.txt (every tracked frame), "
-      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv, "
-      "OUT/stats.json and OUT/run_config.yaml (the config used). With ground truth, prints ATE.");
-  auto flags = std::make_shared<RunFlags>();
+}  // namespace
+
+int run_slam(const RunFlags& flags, const GlobalOptions& global) {
+  use_single_threaded_blas();  // in every run: its calls are small, its spinning workers are not
+  RunOptions options = run_options(flags, global);
+  const RunSettings settings = run_settings(flags);
+  options.system = system_options(settings);
+  SystemOptions& system = options.system;
+  // OpenCV's pool is process-wide: with one thread the network runs on the (lowered) semantic
+  // thread alone instead of borrowing workers that compete with tracking at full priority.
+  if (flags.opencv_threads >= 0)
+    cv::setNumThreads(flags.opencv_threads);
+  else if (settings.live())
+    cv::setNumThreads(1);
+  set_cli_only_options(flags, system);
+
+  std::optional<RunInput> camera = open_camera_input(flags, options.sensor);
+  // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
+  // second of frames, so a live run without --realtime waits for local mapping only.
+  if (!flags.realtime && camera && camera->source->live())
+    system.back_end_wait = BackEndWait::local_mapping;
+  std::unique_ptr<LiveViewer> viewer = start_viewer(flags, system);
+  SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
+                                 : SequenceRunner(std::move(options), std::cout);
+  runner.watch(viewer.get());
+  return exit_status(runner.run());
+}
+
+namespace {
+
+// What the run reads (a sequence, a camera or a video, with its config and sensor), where it
+// writes and how much of it runs. Returns --sequence, which other options need.
+CLI::Option* add_input_options(CLI::App* app, const std::shared_ptr<RunFlags>& flags) {
   CLI::Option* sequence = app->add_option("--sequence", flags->sequence, "sequence folder");
   CLI::Option* camera = app->add_option("--camera", flags->camera,
                                         "read a live camera instead of a folder: "
@@ -331,56 +349,69 @@ Command add_run_command(CLI::App& root) {
       ->capture_default_str();
   app->add_flag("--no-local-mapping", flags->no_local_mapping,
                 "track only: keyframes enter the map but are never refined (debugging)");
-  app->add_option("--dynamic", flags->dynamic,
+  return sequence;
+}
+
+// How dynamic content is found.
+void add_dynamic_options(CLI::App* app, RunFlags& flags) {
+  app->add_option("--dynamic", flags.dynamic,
                   "dynamic-scene mode: off | semantic | geometry | full | exhaustive | auto "
                   "(auto = full when the segmentation model loads, else geometry)")
       ->check(CLI::IsMember({"off", "semantic", "geometry", "full", "exhaustive", "auto"}))
       ->capture_default_str();
-  app->add_option("--model", flags->model,
+  app->add_option("--model", flags.model,
                   "segmentation metadata YAML (default: the shipped models/pspnet/pspnet.yaml)");
-  app->add_flag("--realtime", flags->realtime,
+}
+
+// Real-time runs: how frames are fed and how the threads share the cores.
+void add_live_options(CLI::App* app, RunFlags& flags) {
+  app->add_flag("--realtime", flags.realtime,
                 "feed frames at the sequence's rate (late frames are dropped) and never wait for "
                 "segmentation or the back end: use the newest mask, warped into the frame "
                 "(default: deterministic, each frame waits for its mask and for local mapping, "
                 "loop closing and any global BA to finish the previous keyframe; a camera waits "
                 "for local mapping only)");
-  app->add_option("--preload", flags->preload,
+  app->add_option("--preload", flags.preload,
                   "with --realtime on a recording: on = decode every frame before the replay "
                   "starts, so that no image decoding shares the cores with the run (a camera "
                   "delivers decoded frames; refused above 8 GiB), off = decode each frame ahead "
                   "on a reader thread, auto = on up to 2 GiB of decoded frames")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  app->add_option("--background-nice", flags->background_nice,
+  app->add_option("--background-nice", flags.background_nice,
                   "scheduling priority given up by the semantic, local mapping and loop closing "
                   "threads (nice increment, 0-19) so that tracking gets a core when a frame "
                   "arrives (default: " +
                       std::to_string(kLiveBackgroundNice) +
                       " with --realtime or --camera, 0 otherwise)")
       ->check(in_range(0, 19));
-  app->add_option("--opencv-threads", flags->opencv_threads,
+  app->add_option("--opencv-threads", flags.opencv_threads,
                   "OpenCV worker threads (network, image operations; 0 = OpenCV's default, all "
                   "cores). Default: 1 with --realtime or --camera, so that the network runs on "
                   "the lowered semantic thread alone; OpenCV's default otherwise")
       ->check(in_range(0, 256));
-  app->add_option("--segment-every", flags->segment_every,
+}
+
+// How often the network runs and how the frames between use an older mask.
+void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
+  app->add_option("--segment-every", flags.segment_every,
                   "segment every n-th frame; the frames between use the newest mask, moved "
                   "with the camera by the frame-to-frame homographies")
       ->check(in_range(1, 30))
       ->capture_default_str();
-  app->add_option("--semantic-pace", flags->semantic_pace,
+  app->add_option("--semantic-pace", flags.semantic_pace,
                   "with --realtime: when segmentation falls behind the camera, step down by "
                   "itself to the smaller network input (--smaller-model), then to segmenting "
                   "every 2nd or 3rd frame, and back up when there is room (off: one network on "
                   "every frame it can take)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
-  app->add_option("--smaller-model", flags->smaller_model,
+  app->add_option("--smaller-model", flags.smaller_model,
                   "the smaller segmentation model --semantic-pace steps down to (default: the "
                   "shipped models/pspnet/pspnet_288x192.yaml when --model is the shipped one, "
                   "else none: only sparser frames)")
       ->check(CLI::ExistingFile);
-  app->add_option("--stale-masks", flags->stale_masks,
+  app->add_option("--stale-masks", flags.stale_masks,
                   "with --realtime, how an older mask is brought into the frame: flow = each "
                   "person moves by the optical flow inside it and the mask grows with its age, "
                   "and keypoints near a mask more than 2 frames old get the geometry test "
@@ -388,23 +419,28 @@ Command add_run_command(CLI::App& root) {
                   "moved with the camera only")
       ->check(CLI::IsMember({"flow", "homography"}))
       ->capture_default_str();
-  app->add_option("--stale-mask-growth", flags->stale_mask_growth,
+  app->add_option("--stale-mask-growth", flags.stale_mask_growth,
                   "with --stale-masks flow: the most pixels a moved mask grows by for its age")
       ->check(in_range(0, 200))
       ->capture_default_str();
-  app->add_option("--stale-geometry", flags->stale_geometry,
+  app->add_option("--stale-geometry", flags.stale_geometry,
                   "with --realtime and --stale-masks flow: while the mask is more than 2 frames "
                   "old, every keypoint in a band around it gets the multi-view geometry test")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
-  app->add_option("--mover-guard", flags->mover_guard,
+  app->add_option("--mover-guard", flags.mover_guard,
                   "experimental: when a frame's inliers drop and its pose jumps off the "
                   "constant-velocity prediction (tracking following a crowd), hold the "
                   "prediction for up to 3 frames")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+}
+
+// Where the semantic masks come from (the network, slowed down on purpose, or a folder) and
+// how far they are grown.
+void add_mask_source_options(CLI::App* app, RunFlags& flags, CLI::Option* sequence) {
   CLI::Option* semantic_delay =
-      app->add_option("--semantic-delay-ms", flags->semantic_delay,
+      app->add_option("--semantic-delay-ms", flags.semantic_delay,
                       "fault injection: MS or random:MIN:MAX milliseconds of extra wait after each "
                       "segmentation, as if the network were that much slower (reproduces a "
                       "network that falls behind the camera)")
@@ -418,62 +454,72 @@ Command add_run_command(CLI::App& root) {
                 }
               },
               "MS|random:MIN:MAX"));
-  app->add_option("--semantic-delay-seed", flags->semantic_delay_seed,
+  app->add_option("--semantic-delay-seed", flags.semantic_delay_seed,
                   "seed of the random:MIN:MAX delays (the same seed draws the same delays)")
       ->needs(semantic_delay)
       ->capture_default_str();
-  app->add_option("--semantic-masks", flags->semantic_masks,
+  app->add_option("--semantic-masks", flags.semantic_masks,
                   "read each frame's semantic mask from this folder instead of running the "
                   "network: DIR/<colour image name>.png, 8-bit, non-zero = dynamic (what "
                   "--save-masks writes; a synth sequence's mask/ folder); grown by --mask-margin")
       ->check(CLI::ExistingDirectory)
       ->needs(sequence);
-  app->add_option("--mask-margin", flags->mask_margin,
+  app->add_option("--mask-margin", flags.mask_margin,
                   "dilation of the semantic dynamic mask (pixels)")
       ->check(in_range(0, 100))
       ->capture_default_str();
-  app->add_option("--keyframe-ratio", flags->keyframe_ratio,
+}
+
+// When a frame becomes a keyframe, how far local BA reaches and how a frame's pose is
+// optimised.
+void add_keyframe_options(CLI::App* app, RunFlags& flags) {
+  app->add_option("--keyframe-ratio", flags.keyframe_ratio,
                   "a frame becomes a keyframe when it tracks fewer than this share of its "
                   "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)")
       ->check(in_range(0.01, 1.0))
       ->capture_default_str();
-  app->add_option("--local-ba-keyframes", flags->local_ba_keyframes,
+  app->add_option("--local-ba-keyframes", flags.local_ba_keyframes,
                   "local BA optimises the new keyframe and at most this many of its best "
                   "covisible keyframes; 0 = all of them, as ORB-SLAM2 (default: " +
                       std::to_string(kLiveLocalBaKeyframes) +
                       " with --realtime or --camera, so that local BA keeps up on two cores; 0 "
                       "otherwise)")
       ->check(in_range(0, 1000));
-  app->add_flag("--due-keyframes", flags->due_keyframes,
+  app->add_flag("--due-keyframes", flags.due_keyframes,
                 "also make a keyframe once a second has passed since the last one, whatever "
                 "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "
                 "off by default: docs/decisions/due-keyframes.md)");
-  app->add_option("--motion-prior", flags->motion_prior,
+  app->add_option("--motion-prior", flags.motion_prior,
                   "MM DEG: optimise each frame tracked with the motion model with its "
                   "constant-velocity prediction as a prior of these σs (translation mm, rotation "
                   "degrees; default: no prior; it lowers the jitter, not the ATE)")
       ->expected(2)
       ->check(in_range(1e-3, 1e3));
-  app->add_option("--vocabulary", flags->vocabulary,
+}
+
+// The map: vocabulary, relocalisation, loop closing, saved maps, forced tracking loss and
+// culling of dynamic points.
+void add_map_options(CLI::App* app, RunFlags& flags) {
+  app->add_option("--vocabulary", flags.vocabulary,
                   "ORB bag-of-words vocabulary for relocalisation and loop closing (default: the "
                   "shipped models/vocabulary/orb_k10_l5.pspvoc)");
-  app->add_flag("--no-relocalization", flags->no_relocalization,
+  app->add_flag("--no-relocalization", flags.no_relocalization,
                 "do not relocalise when tracking is lost (and do not load the vocabulary)");
-  app->add_option("--loop-closing", flags->loop_closing,
+  app->add_option("--loop-closing", flags.loop_closing,
                   "loop closing thread (detection, essential-graph correction, global BA); auto = "
                   "on when the vocabulary file exists")
       ->check(CLI::IsMember({"on", "off", "auto"}))
       ->capture_default_str();
-  app->add_option("--save-map", flags->save_map,
+  app->add_option("--save-map", flags.save_map,
                   "write the final map to this file (binary, see docs/place_recognition.md)");
   CLI::Option* load_map =
-      app->add_option("--load-map", flags->load_map,
+      app->add_option("--load-map", flags.load_map,
                       "start from this saved map: the first frame is relocalised in it")
           ->check(CLI::ExistingFile);
-  app->add_flag("--localization", flags->localization,
+  app->add_flag("--localization", flags.localization,
                 "localisation only (needs --load-map): track in the map, never add to it")
       ->needs(load_map);
-  app->add_option("--blackout", flags->blackout,
+  app->add_option("--blackout", flags.blackout,
                   "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
                   "(tracking is lost for real; tests relocalisation)")
       ->check(CLI::Validator(
@@ -486,38 +532,68 @@ Command add_run_command(CLI::App& root) {
             }
           },
           "FROM:COUNT"));
-  app->add_option("--cull-hits", flags->cull_hits,
+  app->add_option("--cull-hits", flags.cull_hits,
                   "erase a map point after it lay on dynamic pixels in this many frames")
       ->check(in_range(1, 1000))
       ->capture_default_str();
-  app->add_option("--export-map", flags->export_map,
+}
+
+// Optional outputs beside the trajectory files: point clouds, masks and overlays.
+void add_output_options(CLI::App* app, RunFlags& flags) {
+  app->add_option("--export-map", flags.export_map,
                   "write the final static map points as a PLY point cloud (dynamic points never "
                   "enter the map or are culled from it)");
-  app->add_option("--export-dense", flags->export_dense,
+  app->add_option("--export-dense", flags.export_dense,
                   "also write a dense PLY cloud back-projected from the keyframes' depth at their "
                   "final poses, dynamic pixels left out (1 cm voxels, every 4th pixel)");
-  app->add_option("--save-masks", flags->save_masks,
+  app->add_option("--save-masks", flags.save_masks,
                   "write each processed frame's final dynamic mask (semantic + geometry) into "
                   "this folder: 8-bit PNG, 255 = dynamic, named after the colour image "
                   "(rgb/1548339828.32144.png -> DIR/1548339828.32144.png)");
-  app->add_option("--save-overlays", flags->save_overlays,
+  app->add_option("--save-overlays", flags.save_overlays,
                   "write a picture per processed frame into this folder: the semantic overlay with "
                   "every keypoint marked by its fate (tracked / kept unmatched / dropped by the "
                   "semantic mask / dropped by the geometry test) and a legend; costs a second ORB "
                   "extraction per frame");
+}
+
+// The live viewer in the browser.
+void add_viewer_options(CLI::App* app, RunFlags& flags) {
   CLI::Option* viewer =
-      app->add_option("--viewer", flags->viewer,
+      app->add_option("--viewer", flags.viewer,
                       "[HOST:]PORT: show the run live in the browser (frame, keypoint fates, "
                       "masks, map, timing; host 127.0.0.1 unless given; port 0: any free one)");
-  app->add_flag("--viewer-paused", flags->viewer_paused,
+  app->add_flag("--viewer-paused", flags.viewer_paused,
                 "hold the run after its first frame until the page says resume or step "
                 "(deterministic runs)")
       ->needs(viewer);
-  app->add_option("--viewer-interval", flags->viewer_interval_ms,
+  app->add_option("--viewer-interval", flags.viewer_interval_ms,
                   "milliseconds between the frames the viewer shows (the run never waits for it)")
       ->check(in_range(10, 60000))
       ->needs(viewer)
       ->capture_default_str();
+}
+
+}  // namespace
+
+Command add_run_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "run",
+      "run SLAM on an RGB-D sequence and write the trajectory.\n"
+      "Reads a sequence in TUM layout (rgb.txt, depth.txt or associations.txt, optional "
+      "groundtruth.txt)\nand writes OUT/trajectory.txt (every tracked frame), "
+      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv, "
+      "OUT/stats.json and OUT/run_config.yaml (the config used). With ground truth, prints ATE.");
+  auto flags = std::make_shared<RunFlags>();
+  CLI::Option* sequence = add_input_options(app, flags);
+  add_dynamic_options(app, *flags);
+  add_live_options(app, *flags);
+  add_stale_mask_options(app, *flags);
+  add_mask_source_options(app, *flags, sequence);
+  add_keyframe_options(app, *flags);
+  add_map_options(app, *flags);
+  add_output_options(app, *flags);
+  add_viewer_options(app, *flags);
   return {app, [flags](const GlobalOptions& global) { return run_slam(*flags, global); }};
 }
 

@@ -104,11 +104,118 @@ struct TrainFlags {
   bool progress = true;
 };
 
+// The ORB descriptors of every training view, one matrix per view.
+struct TrainingDescriptors {
+  std::vector<cv::Mat> images;
+  std::size_t total = 0;
+  size_t photo_views = 0;
+  size_t synthetic_frames = 0;
+};
+
+class DescriptorCollector {
+ public:
+  explicit DescriptorCollector(TrainingDescriptors& collected) : collected_(collected) {}
+
+  // Views without a single keypoint (smooth sky, gradients) are no training images.
+  bool add_view(const cv::Mat& gray) {
+    extractor_.extract(gray, cv::Mat(), features_);
+    if (features_.descriptors.rows == 0) return false;
+    collected_.images.push_back(features_.descriptors.clone());
+    collected_.total += static_cast<std::size_t>(features_.descriptors.rows);
+    return true;
+  }
+
+ private:
+  TrainingDescriptors& collected_;
+  OrbExtractor extractor_{OrbConfig{}};
+  OrbFeatures features_;
+};
+
+TrainingDescriptors extract_training_descriptors(const std::vector<fs::path>& photos,
+                                                 const TrainFlags& flags) {
+  const int synthetic_frames = flags.synthetic_frames;
+  TrainingDescriptors collected;
+  DescriptorCollector collector(collected);
+  ProgressBar extract_progress("orb", photos.size() + static_cast<size_t>(synthetic_frames),
+                               std::cerr, flags.progress);
+  size_t done = 0;
+  for (const fs::path& photo : photos) {
+    const cv::Mat gray = cv::imread(photo.string(), cv::IMREAD_GRAYSCALE);
+    if (gray.empty()) throw Error("vocab train: cannot read image '" + photo.string() + "'");
+    for (const cv::Mat& view : photo_views(gray))
+      collected.photo_views += collector.add_view(view) ? 1 : 0;
+    extract_progress.update(++done);
+  }
+  if (synthetic_frames > 0) {
+    SynthFrame frame;
+    cv::Mat gray;
+    for (int first = 0; first < synthetic_frames; first += kFramesPerSeed) {
+      SynthOptions options;
+      options.frames = kSynthSequenceFrames;
+      options.seed = static_cast<std::uint64_t>(flags.synthetic_seed + first / kFramesPerSeed);
+      const SyntheticScene scene(options);
+      const int count = std::min(kFramesPerSeed, synthetic_frames - first);
+      for (int i = 0; i < count; ++i) {
+        scene.render(static_cast<size_t>(i) * (kSynthSequenceFrames / kFramesPerSeed), frame, 0);
+        cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+        collected.synthetic_frames += collector.add_view(gray) ? 1 : 0;
+        extract_progress.update(++done);
+      }
+    }
+  }
+  extract_progress.finish();
+  return collected;
+}
+
+// Uniform random subsample for the tree (k-means cost grows with it); IDF uses every image.
+cv::Mat sample_descriptors(const TrainingDescriptors& collected, std::size_t sample,
+                           std::uint64_t seed) {
+  std::vector<std::uint32_t> order(collected.total);
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::mt19937_64 rng(seed);
+  if (sample < collected.total) {
+    std::shuffle(order.begin(), order.end(), rng);
+    order.resize(sample);
+    std::sort(order.begin(), order.end());
+  }
+  cv::Mat tree_descriptors(static_cast<int>(sample), kOrbDescriptorBytes, CV_8UC1);
+  std::size_t image = 0;
+  std::size_t image_start = 0;
+  for (std::size_t i = 0; i < sample; ++i) {
+    while (order[i] >= image_start + static_cast<std::size_t>(collected.images[image].rows)) {
+      image_start += static_cast<std::size_t>(collected.images[image].rows);
+      ++image;
+    }
+    collected.images[image]
+        .row(static_cast<int>(order[i] - image_start))
+        .copyTo(tree_descriptors.row(static_cast<int>(i)));
+  }
+  return tree_descriptors;
+}
+
+// k-means tree and IDF weights, each with its progress bar.
+Vocabulary train_vocabulary(const cv::Mat& tree_descriptors,
+                            const std::vector<cv::Mat>& image_descriptors,
+                            const VocabularyParams& params, bool progress) {
+  ProgressBar tree_progress("k-means", static_cast<size_t>(tree_descriptors.rows), std::cerr,
+                            progress);
+  ProgressBar idf_progress("idf", image_descriptors.size(), std::cerr, progress);
+  return Vocabulary::train(tree_descriptors, image_descriptors, params,
+                           [&](const std::string& stage, std::size_t n, std::size_t total) {
+                             if (stage == "tree") {
+                               tree_progress.update(n);
+                               if (n == total) tree_progress.finish();
+                             } else {
+                               idf_progress.update(n);
+                               if (n == total) idf_progress.finish();
+                             }
+                           });
+}
+
 int train(const TrainFlags& flags) {
   const VocabularyParams& params = flags.params;
   params.validate();
   const int synthetic_frames = flags.synthetic_frames;
-  const int synthetic_seed = flags.synthetic_seed;
   const int max_descriptors = flags.max_descriptors;
   if (max_descriptors < params.branching) {
     throw Error("vocab train: --max-descriptors must be >= --k, got " +
@@ -124,97 +231,23 @@ int train(const TrainFlags& flags) {
   }
 
   const auto start = Clock::now();
-  OrbExtractor extractor{OrbConfig{}};
-  OrbFeatures features;
-  std::vector<cv::Mat> image_descriptors;
-  std::size_t total_descriptors = 0;
-  // Views without a single keypoint (smooth sky, gradients) are no training images.
-  auto add_view = [&](const cv::Mat& gray) {
-    extractor.extract(gray, cv::Mat(), features);
-    if (features.descriptors.rows == 0) return false;
-    image_descriptors.push_back(features.descriptors.clone());
-    total_descriptors += static_cast<std::size_t>(features.descriptors.rows);
-    return true;
-  };
-
   std::cout << "training images: " << photos.size() << " photographs, " << synthetic_frames
             << " synthetic frames\n";
-  ProgressBar extract_progress("orb", photos.size() + static_cast<size_t>(synthetic_frames),
-                               std::cerr, flags.progress);
-  size_t done = 0;
-  size_t photo_views_used = 0;
-  size_t synthetic_used = 0;
-  for (const fs::path& photo : photos) {
-    const cv::Mat gray = cv::imread(photo.string(), cv::IMREAD_GRAYSCALE);
-    if (gray.empty()) throw Error("vocab train: cannot read image '" + photo.string() + "'");
-    for (const cv::Mat& view : photo_views(gray)) photo_views_used += add_view(view) ? 1 : 0;
-    extract_progress.update(++done);
-  }
-  if (synthetic_frames > 0) {
-    SynthFrame frame;
-    cv::Mat gray;
-    for (int first = 0; first < synthetic_frames; first += kFramesPerSeed) {
-      SynthOptions options;
-      options.frames = kSynthSequenceFrames;
-      options.seed = static_cast<std::uint64_t>(synthetic_seed + first / kFramesPerSeed);
-      const SyntheticScene scene(options);
-      const int count = std::min(kFramesPerSeed, synthetic_frames - first);
-      for (int i = 0; i < count; ++i) {
-        scene.render(static_cast<size_t>(i) * (kSynthSequenceFrames / kFramesPerSeed), frame, 0);
-        cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-        synthetic_used += add_view(gray) ? 1 : 0;
-        extract_progress.update(++done);
-      }
-    }
-  }
-  extract_progress.finish();
-  std::cout << "descriptors: " << total_descriptors << " from " << image_descriptors.size()
-            << " images (" << photo_views_used << " photograph views, " << synthetic_used
-            << " synthetic frames), extraction " << seconds_since(start) << " s\n";
-  if (total_descriptors < static_cast<std::size_t>(params.branching)) {
-    throw Error("vocab train: only " + std::to_string(total_descriptors) +
+  const TrainingDescriptors collected = extract_training_descriptors(photos, flags);
+  std::cout << "descriptors: " << collected.total << " from " << collected.images.size()
+            << " images (" << collected.photo_views << " photograph views, "
+            << collected.synthetic_frames << " synthetic frames), extraction "
+            << seconds_since(start) << " s\n";
+  if (collected.total < static_cast<std::size_t>(params.branching)) {
+    throw Error("vocab train: only " + std::to_string(collected.total) +
                 " descriptors found, need at least --k");
   }
-
-  // Uniform random subsample for the tree (k-means cost grows with it); IDF uses every image.
-  std::vector<std::uint32_t> order(total_descriptors);
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
-  std::mt19937_64 rng(params.seed);
-  const std::size_t sample = std::min(total_descriptors, static_cast<std::size_t>(max_descriptors));
-  if (sample < total_descriptors) {
-    std::shuffle(order.begin(), order.end(), rng);
-    order.resize(sample);
-    std::sort(order.begin(), order.end());
-  }
-  cv::Mat tree_descriptors(static_cast<int>(sample), kOrbDescriptorBytes, CV_8UC1);
-  {
-    std::size_t image = 0;
-    std::size_t image_start = 0;
-    for (std::size_t i = 0; i < sample; ++i) {
-      while (order[i] >= image_start + static_cast<std::size_t>(image_descriptors[image].rows)) {
-        image_start += static_cast<std::size_t>(image_descriptors[image].rows);
-        ++image;
-      }
-      image_descriptors[image]
-          .row(static_cast<int>(order[i] - image_start))
-          .copyTo(tree_descriptors.row(static_cast<int>(i)));
-    }
-  }
+  const std::size_t sample = std::min(collected.total, static_cast<std::size_t>(max_descriptors));
+  const cv::Mat tree_descriptors = sample_descriptors(collected, sample, params.seed);
 
   const auto kmeans_start = Clock::now();
-  ProgressBar tree_progress("k-means", sample, std::cerr, flags.progress);
-  ProgressBar idf_progress("idf", image_descriptors.size(), std::cerr, flags.progress);
   const Vocabulary vocabulary =
-      Vocabulary::train(tree_descriptors, image_descriptors, params,
-                        [&](const std::string& stage, std::size_t n, std::size_t total) {
-                          if (stage == "tree") {
-                            tree_progress.update(n);
-                            if (n == total) tree_progress.finish();
-                          } else {
-                            idf_progress.update(n);
-                            if (n == total) idf_progress.finish();
-                          }
-                        });
+      train_vocabulary(tree_descriptors, collected.images, params, flags.progress);
   const double kmeans_seconds = seconds_since(kmeans_start);
   vocabulary.save(out);
   const double total_seconds = seconds_since(start);
@@ -224,8 +257,8 @@ int train(const TrainFlags& flags) {
   const double load_seconds = seconds_since(load_start);
   std::cout << "vocabulary: k " << vocabulary.branching() << ", L " << vocabulary.levels() << ", "
             << vocabulary.node_count() << " nodes, " << vocabulary.word_count() << " words, "
-            << sample << " descriptors clustered (of " << total_descriptors << "), "
-            << image_descriptors.size() << " images for IDF\n"
+            << sample << " descriptors clustered (of " << collected.total << "), "
+            << collected.images.size() << " images for IDF\n"
             << "time: k-means + IDF " << kmeans_seconds << " s, total " << total_seconds
             << " s\nwrote " << out.string() << " (" << fs::file_size(out) << " bytes), loads in "
             << load_seconds * 1e3 << " ms (" << reloaded.word_count() << " words)\n";

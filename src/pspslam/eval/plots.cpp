@@ -138,13 +138,8 @@ std::pair<double, double> colour_bar_range(const ColourBar& bar) {
   return {bar.low, bar.high > bar.low ? bar.high : bar.low + 1.0};
 }
 
-// Draws the whole plot as SVG elements in plot coordinates (no document header).
-std::string svg_body(const LinePlot& plot) {
-  const Layout L = make_layout(plot);
+std::string svg_grid(const Layout& L) {
   std::string svg;
-  svg += "<rect width=\"" + std::to_string(plot.width) + "\" height=\"" +
-         std::to_string(plot.height) + "\" fill=\"white\"/>\n";
-  // Grid and tick labels.
   for (const double x : ticks(L.x_min, L.x_max, L.x_step)) {
     svg += "<line x1=\"" + number(L.px(x)) + "\" y1=\"" + number(L.top) + "\" x2=\"" +
            number(L.px(x)) + "\" y2=\"" + number(L.top + L.frame_height()) +
@@ -162,63 +157,71 @@ std::string svg_body(const LinePlot& plot) {
   svg += "<rect x=\"" + number(L.left) + "\" y=\"" + number(L.top) + "\" width=\"" +
          number(L.frame_width()) + "\" height=\"" + number(L.frame_height()) +
          "\" fill=\"none\" stroke=\"black\"/>\n";
-  const auto [scale_low, scale_high] =
-      plot.colour_bar ? colour_bar_range(*plot.colour_bar) : std::make_pair(0.0, 1.0);
-  for (const PlotSeries& s : plot.series) {
-    if (s.points.empty()) continue;
-    if (s.values.size() == s.points.size()) {
-      // One segment per pair of points, each in the colour of its mean value.
-      for (size_t i = 1; i < s.points.size(); ++i) {
-        const double value = 0.5 * (s.values[i - 1] + s.values[i]);
-        svg += "<line x1=\"" + number(L.px(s.points[i - 1].x())) + "\" y1=\"" +
-               number(L.py(s.points[i - 1].y())) + "\" x2=\"" + number(L.px(s.points[i].x())) +
-               "\" y2=\"" + number(L.py(s.points[i].y())) + "\" stroke=\"" +
-               svg_colour(error_colour(value, scale_low, scale_high)) +
-               "\" stroke-width=\"2.5\" stroke-linecap=\"round\"/>\n";
-      }
-      continue;
+  return svg;
+}
+
+std::string svg_series(const Layout& L, const PlotSeries& s, double scale_low, double scale_high) {
+  if (s.points.empty()) return {};
+  std::string svg;
+  if (s.values.size() == s.points.size()) {
+    // One segment per pair of points, each in the colour of its mean value.
+    for (size_t i = 1; i < s.points.size(); ++i) {
+      const double value = 0.5 * (s.values[i - 1] + s.values[i]);
+      svg += "<line x1=\"" + number(L.px(s.points[i - 1].x())) + "\" y1=\"" +
+             number(L.py(s.points[i - 1].y())) + "\" x2=\"" + number(L.px(s.points[i].x())) +
+             "\" y2=\"" + number(L.py(s.points[i].y())) + "\" stroke=\"" +
+             svg_colour(error_colour(value, scale_low, scale_high)) +
+             "\" stroke-width=\"2.5\" stroke-linecap=\"round\"/>\n";
     }
-    svg += "<polyline fill=\"none\" stroke=\"" + svg_colour(s.red, s.green, s.blue) +
-           "\" stroke-width=\"1.5\" points=\"";
-    for (const Eigen::Vector2d& p : s.points)
-      svg += number(L.px(p.x())) + "," + number(L.py(p.y())) + " ";
-    svg += "\"/>\n";
+    return svg;
   }
-  const auto svg_marker = [](const PlotMarker& m, double x, double y) {
-    const std::string colour = svg_colour(m.red, m.green, m.blue);
-    if (m.square) {
-      return "<rect x=\"" + number(x - 6) + "\" y=\"" + number(y - 6) +
-             "\" width=\"12\" height=\"12\" fill=\"" + colour + "\" stroke=\"black\"/>\n";
-    }
-    return "<circle cx=\"" + number(x) + "\" cy=\"" + number(y) + "\" r=\"6\" fill=\"" + colour +
-           "\" stroke=\"black\"/>\n";
-  };
-  for (const PlotMarker& m : plot.markers)
-    svg += svg_marker(m, L.px(m.point.x()), L.py(m.point.y()));
-  if (plot.colour_bar) {
-    const double bar_x = L.left + L.frame_width() + 24, bar_top = L.top + 24;
-    const double bar_bottom = L.top + L.frame_height(), bar_height = bar_bottom - bar_top;
-    constexpr int kSteps = 64;
-    for (int i = 0; i < kSteps; ++i) {
-      const double value = scale_low + (scale_high - scale_low) * (i + 0.5) / kSteps;
-      svg += "<rect x=\"" + number(bar_x) + "\" y=\"" +
-             number(bar_bottom - bar_height * (i + 1) / kSteps) + "\" width=\"18\" height=\"" +
-             number(bar_height / kSteps + 0.5) + "\" fill=\"" +
-             svg_colour(error_colour(value, scale_low, scale_high)) + "\"/>\n";
-    }
-    svg += "<rect x=\"" + number(bar_x) + "\" y=\"" + number(bar_top) +
-           "\" width=\"18\" height=\"" + number(bar_height) +
-           "\" fill=\"none\" stroke=\"black\"/>\n";
-    const double step = nice_step(scale_high - scale_low, 5);
-    for (const double v : ticks(scale_low, scale_high, step)) {
-      const double y = bar_bottom - (v - scale_low) / (scale_high - scale_low) * bar_height;
-      svg += "<text x=\"" + number(bar_x + 24) + "\" y=\"" + number(y + 4) + "\">" +
-             format_tick(v, step) + "</text>\n";
-    }
-    svg += "<text x=\"" + number(bar_x + 9) + "\" y=\"" + number(bar_top - 8) +
-           "\" text-anchor=\"middle\">" + escape_xml(plot.colour_bar->label) + "</text>\n";
+  svg += "<polyline fill=\"none\" stroke=\"" + svg_colour(s.red, s.green, s.blue) +
+         "\" stroke-width=\"1.5\" points=\"";
+  for (const Eigen::Vector2d& p : s.points)
+    svg += number(L.px(p.x())) + "," + number(L.py(p.y())) + " ";
+  svg += "\"/>\n";
+  return svg;
+}
+
+std::string svg_marker(const PlotMarker& m, double x, double y) {
+  const std::string colour = svg_colour(m.red, m.green, m.blue);
+  if (m.square) {
+    return "<rect x=\"" + number(x - 6) + "\" y=\"" + number(y - 6) +
+           "\" width=\"12\" height=\"12\" fill=\"" + colour + "\" stroke=\"black\"/>\n";
   }
-  // Title, axis labels, legend.
+  return "<circle cx=\"" + number(x) + "\" cy=\"" + number(y) + "\" r=\"6\" fill=\"" + colour +
+         "\" stroke=\"black\"/>\n";
+}
+
+std::string svg_colour_bar(const Layout& L, const ColourBar& bar) {
+  const auto [scale_low, scale_high] = colour_bar_range(bar);
+  const double bar_x = L.left + L.frame_width() + 24, bar_top = L.top + 24;
+  const double bar_bottom = L.top + L.frame_height(), bar_height = bar_bottom - bar_top;
+  constexpr int kSteps = 64;
+  std::string svg;
+  for (int i = 0; i < kSteps; ++i) {
+    const double value = scale_low + (scale_high - scale_low) * (i + 0.5) / kSteps;
+    svg += "<rect x=\"" + number(bar_x) + "\" y=\"" +
+           number(bar_bottom - bar_height * (i + 1) / kSteps) + "\" width=\"18\" height=\"" +
+           number(bar_height / kSteps + 0.5) + "\" fill=\"" +
+           svg_colour(error_colour(value, scale_low, scale_high)) + "\"/>\n";
+  }
+  svg += "<rect x=\"" + number(bar_x) + "\" y=\"" + number(bar_top) + "\" width=\"18\" height=\"" +
+         number(bar_height) + "\" fill=\"none\" stroke=\"black\"/>\n";
+  const double step = nice_step(scale_high - scale_low, 5);
+  for (const double v : ticks(scale_low, scale_high, step)) {
+    const double y = bar_bottom - (v - scale_low) / (scale_high - scale_low) * bar_height;
+    svg += "<text x=\"" + number(bar_x + 24) + "\" y=\"" + number(y + 4) + "\">" +
+           format_tick(v, step) + "</text>\n";
+  }
+  svg += "<text x=\"" + number(bar_x + 9) + "\" y=\"" + number(bar_top - 8) +
+         "\" text-anchor=\"middle\">" + escape_xml(bar.label) + "</text>\n";
+  return svg;
+}
+
+// Title and axis labels.
+std::string svg_labels(const Layout& L, const LinePlot& plot) {
+  std::string svg;
   svg += "<text x=\"" + number(plot.width / 2.0) + "\" y=\"28\" text-anchor=\"middle\" " +
          "font-size=\"16\">" + escape_xml(plot.title) + "</text>\n";
   svg += "<text x=\"" + number(L.left + L.frame_width() / 2) + "\" y=\"" +
@@ -226,7 +229,11 @@ std::string svg_body(const LinePlot& plot) {
          "</text>\n";
   svg += "<text transform=\"translate(24," + number(L.top + L.frame_height() / 2) +
          ") rotate(-90)\" text-anchor=\"middle\">" + escape_xml(plot.y_label) + "</text>\n";
-  // Legend box in the top-right corner; text width estimated at 7.5 px per character (13 px font).
+  return svg;
+}
+
+// Legend box in the top-right corner; text width estimated at 7.5 px per character (13 px font).
+std::string svg_legend(const Layout& L, const LinePlot& plot) {
   size_t longest = 0;
   for (const PlotSeries& s : plot.series) longest = std::max(longest, s.label.size());
   for (const PlotMarker& m : plot.markers) longest = std::max(longest, m.label.size());
@@ -234,6 +241,7 @@ std::string svg_body(const LinePlot& plot) {
   const double box_width = 7.5 * static_cast<double>(longest) + 56;
   const double box_height = 20.0 * static_cast<double>(rows) + 8;
   const double box_x = L.left + L.frame_width() - box_width - 8, box_y = L.top + 8;
+  std::string svg;
   svg += "<rect x=\"" + number(box_x) + "\" y=\"" + number(box_y) + "\" width=\"" +
          number(box_width) + "\" height=\"" + number(box_height) +
          "\" fill=\"white\" stroke=\"#969696\"/>\n";
@@ -254,6 +262,26 @@ std::string svg_body(const LinePlot& plot) {
            escape_xml(m.label) + "</text>\n";
     legend_y += 20;
   }
+  return svg;
+}
+
+// Draws the whole plot as SVG elements in plot coordinates (no document header).
+std::string svg_body(const LinePlot& plot) {
+  const Layout L = make_layout(plot);
+  std::string svg;
+  svg += "<rect width=\"" + std::to_string(plot.width) + "\" height=\"" +
+         std::to_string(plot.height) + "\" fill=\"white\"/>\n";
+  // Grid and tick labels.
+  svg += svg_grid(L);
+  const auto [scale_low, scale_high] =
+      plot.colour_bar ? colour_bar_range(*plot.colour_bar) : std::make_pair(0.0, 1.0);
+  for (const PlotSeries& s : plot.series) svg += svg_series(L, s, scale_low, scale_high);
+  for (const PlotMarker& m : plot.markers)
+    svg += svg_marker(m, L.px(m.point.x()), L.py(m.point.y()));
+  if (plot.colour_bar) svg += svg_colour_bar(L, *plot.colour_bar);
+  // Title, axis labels, legend.
+  svg += svg_labels(L, plot);
+  svg += svg_legend(L, plot);
   return svg;
 }
 
@@ -287,39 +315,64 @@ cv::Scalar bgr(unsigned char red, unsigned char green, unsigned char blue) {
 
 cv::Scalar bgr(const std::array<unsigned char, 3>& rgb) { return bgr(rgb[0], rgb[1], rgb[2]); }
 
-cv::Mat render_png(const LinePlot& plot) {
-  const Layout L = make_layout(plot);
-  cv::Mat image(plot.height, plot.width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const auto at = [&](double x, double y) {
-    return cv::Point(static_cast<int>(std::lround(L.px(x))),
-                     static_cast<int>(std::lround(L.py(y))));
-  };
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  const cv::Scalar black(0, 0, 0), grid(221, 221, 221);
-  const auto put_text = [&](const std::string& text, cv::Point anchor, double size, int align) {
-    // align: -1 left, 0 centred, 1 right of the anchor.
+// A LinePlot drawn into a picture, step by step.
+class PngPlot {
+ public:
+  explicit PngPlot(const LinePlot& plot)
+      : plot_(plot),
+        L_(make_layout(plot)),
+        image_(plot.height, plot.width, CV_8UC3, cv::Scalar(255, 255, 255)),
+        frame_left_(static_cast<int>(L_.left)),
+        frame_top_(static_cast<int>(L_.top)),
+        frame_right_(static_cast<int>(L_.left + L_.frame_width())),
+        frame_bottom_(static_cast<int>(L_.top + L_.frame_height())) {}
+
+  cv::Mat draw() {
+    draw_grid();
+    const auto [scale_low, scale_high] =
+        plot_.colour_bar ? colour_bar_range(*plot_.colour_bar) : std::make_pair(0.0, 1.0);
+    for (const PlotSeries& s : plot_.series) draw_series(s, scale_low, scale_high);
+    for (const PlotMarker& m : plot_.markers) draw_marker(m, at(m.point.x(), m.point.y()));
+    if (plot_.colour_bar) draw_colour_bar(*plot_.colour_bar);
+    draw_title();
+    put_text(plot_.x_label, {(frame_left_ + frame_right_) / 2, plot_.height - 18}, 0.5, 0);
+    draw_y_label();
+    draw_legend();
+    return image_;
+  }
+
+ private:
+  static constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+  cv::Point at(double x, double y) const {
+    return cv::Point(static_cast<int>(std::lround(L_.px(x))),
+                     static_cast<int>(std::lround(L_.py(y))));
+  }
+
+  // align: -1 left, 0 centred, 1 right of the anchor.
+  void put_text(const std::string& text, cv::Point anchor, double size, int align) {
     int baseline = 0;
-    const cv::Size extent = cv::getTextSize(text, font, size, 1, &baseline);
+    const cv::Size extent = cv::getTextSize(text, kFont, size, 1, &baseline);
     anchor.x -= align == 0 ? extent.width / 2 : (align > 0 ? extent.width : 0);
-    cv::putText(image, text, anchor, font, size, black, 1, cv::LINE_AA);
-  };
-  const int frame_left = static_cast<int>(L.left), frame_top = static_cast<int>(L.top);
-  const int frame_right = static_cast<int>(L.left + L.frame_width());
-  const int frame_bottom = static_cast<int>(L.top + L.frame_height());
-  for (const double x : ticks(L.x_min, L.x_max, L.x_step)) {
-    const int px = at(x, 0).x;
-    cv::line(image, {px, frame_top}, {px, frame_bottom}, grid, 1);
-    put_text(format_tick(x, L.x_step), {px, frame_bottom + 20}, 0.45, 0);
+    cv::putText(image_, text, anchor, kFont, size, kBlack, 1, cv::LINE_AA);
   }
-  for (const double y : ticks(L.y_min, L.y_max, L.y_step)) {
-    const int py = at(0, y).y;
-    cv::line(image, {frame_left, py}, {frame_right, py}, grid, 1);
-    put_text(format_tick(y, L.y_step), {frame_left - 6, py + 5}, 0.45, 1);
+
+  void draw_grid() {
+    const cv::Scalar grid(221, 221, 221);
+    for (const double x : ticks(L_.x_min, L_.x_max, L_.x_step)) {
+      const int px = at(x, 0).x;
+      cv::line(image_, {px, frame_top_}, {px, frame_bottom_}, grid, 1);
+      put_text(format_tick(x, L_.x_step), {px, frame_bottom_ + 20}, 0.45, 0);
+    }
+    for (const double y : ticks(L_.y_min, L_.y_max, L_.y_step)) {
+      const int py = at(0, y).y;
+      cv::line(image_, {frame_left_, py}, {frame_right_, py}, grid, 1);
+      put_text(format_tick(y, L_.y_step), {frame_left_ - 6, py + 5}, 0.45, 1);
+    }
+    cv::rectangle(image_, {frame_left_, frame_top_}, {frame_right_, frame_bottom_}, kBlack, 1);
   }
-  cv::rectangle(image, {frame_left, frame_top}, {frame_right, frame_bottom}, black, 1);
-  const auto [scale_low, scale_high] =
-      plot.colour_bar ? colour_bar_range(*plot.colour_bar) : std::make_pair(0.0, 1.0);
-  for (const PlotSeries& s : plot.series) {
+
+  void draw_series(const PlotSeries& s, double scale_low, double scale_high) {
     std::vector<cv::Point> polyline;
     polyline.reserve(s.points.size());
     for (const Eigen::Vector2d& p : s.points) polyline.push_back(at(p.x(), p.y()));
@@ -327,100 +380,113 @@ cv::Mat render_png(const LinePlot& plot) {
     if (s.values.size() == s.points.size()) {
       for (size_t i = 1; i < polyline.size(); ++i) {
         const double value = 0.5 * (s.values[i - 1] + s.values[i]);
-        cv::line(image, polyline[i - 1], polyline[i],
+        cv::line(image_, polyline[i - 1], polyline[i],
                  bgr(error_colour(value, scale_low, scale_high)), 3, cv::LINE_AA);
       }
-      continue;
+      return;
     }
-    if (polyline.size() == 1) cv::circle(image, polyline[0], 2, colour, cv::FILLED, cv::LINE_AA);
-    cv::polylines(image, polyline, false, colour, 2, cv::LINE_AA);
+    if (polyline.size() == 1) cv::circle(image_, polyline[0], 2, colour, cv::FILLED, cv::LINE_AA);
+    cv::polylines(image_, polyline, false, colour, 2, cv::LINE_AA);
   }
-  const auto draw_marker = [&](const PlotMarker& m, cv::Point p) {
+
+  void draw_marker(const PlotMarker& m, cv::Point p) {
     if (m.square) {
-      cv::rectangle(image, {p.x - 6, p.y - 6}, {p.x + 6, p.y + 6}, bgr(m.red, m.green, m.blue),
+      cv::rectangle(image_, {p.x - 6, p.y - 6}, {p.x + 6, p.y + 6}, bgr(m.red, m.green, m.blue),
                     cv::FILLED);
-      cv::rectangle(image, {p.x - 6, p.y - 6}, {p.x + 6, p.y + 6}, black, 1);
+      cv::rectangle(image_, {p.x - 6, p.y - 6}, {p.x + 6, p.y + 6}, kBlack, 1);
     } else {
-      cv::circle(image, p, 6, bgr(m.red, m.green, m.blue), cv::FILLED, cv::LINE_AA);
-      cv::circle(image, p, 6, black, 1, cv::LINE_AA);
+      cv::circle(image_, p, 6, bgr(m.red, m.green, m.blue), cv::FILLED, cv::LINE_AA);
+      cv::circle(image_, p, 6, kBlack, 1, cv::LINE_AA);
     }
-  };
-  for (const PlotMarker& m : plot.markers) draw_marker(m, at(m.point.x(), m.point.y()));
-  if (plot.colour_bar) {
-    const int bar_x = frame_right + 24, bar_top = frame_top + 24;
-    const int bar_height = frame_bottom - bar_top;
+  }
+
+  void draw_colour_bar(const ColourBar& bar) {
+    const auto [scale_low, scale_high] = colour_bar_range(bar);
+    const int bar_x = frame_right_ + 24, bar_top = frame_top_ + 24;
+    const int bar_height = frame_bottom_ - bar_top;
     for (int row = 0; row < bar_height; ++row) {
       const double value = scale_low + (scale_high - scale_low) * (row + 0.5) / bar_height;
-      cv::line(image, {bar_x, frame_bottom - 1 - row}, {bar_x + 17, frame_bottom - 1 - row},
+      cv::line(image_, {bar_x, frame_bottom_ - 1 - row}, {bar_x + 17, frame_bottom_ - 1 - row},
                bgr(error_colour(value, scale_low, scale_high)), 1);
     }
-    cv::rectangle(image, {bar_x, bar_top}, {bar_x + 18, frame_bottom}, black, 1);
+    cv::rectangle(image_, {bar_x, bar_top}, {bar_x + 18, frame_bottom_}, kBlack, 1);
     const double step = nice_step(scale_high - scale_low, 5);
     for (const double v : ticks(scale_low, scale_high, step)) {
       const int y =
-          frame_bottom -
+          frame_bottom_ -
           static_cast<int>(std::lround((v - scale_low) / (scale_high - scale_low) * bar_height));
-      cv::line(image, {bar_x + 18, y}, {bar_x + 22, y}, black, 1);
+      cv::line(image_, {bar_x + 18, y}, {bar_x + 22, y}, kBlack, 1);
       put_text(format_tick(v, step), {bar_x + 25, y + 5}, 0.45, -1);
     }
-    put_text(plot.colour_bar->label, {bar_x + 9, bar_top - 8}, 0.45, 0);
+    put_text(bar.label, {bar_x + 9, bar_top - 8}, 0.45, 0);
   }
+
   // The title shrinks to fit the picture's width (long sequence names).
-  {
+  void draw_title() {
     double size = 0.6;
     int baseline = 0;
     while (size > 0.35 &&
-           cv::getTextSize(plot.title, font, size, 1, &baseline).width > plot.width - 20) {
+           cv::getTextSize(plot_.title, kFont, size, 1, &baseline).width > plot_.width - 20) {
       size -= 0.05;
     }
-    put_text(plot.title, {plot.width / 2, 30}, size, 0);
+    put_text(plot_.title, {plot_.width / 2, 30}, size, 0);
   }
-  put_text(plot.x_label, {(frame_left + frame_right) / 2, plot.height - 18}, 0.5, 0);
+
   // OpenCV has no rotated text: draw the y label horizontally, then rotate that strip.
-  {
+  void draw_y_label() {
     int baseline = 0;
-    const cv::Size extent = cv::getTextSize(plot.y_label, font, 0.5, 1, &baseline);
+    const cv::Size extent = cv::getTextSize(plot_.y_label, kFont, 0.5, 1, &baseline);
     cv::Mat strip(extent.height + baseline + 6, extent.width + 6, CV_8UC3,
                   cv::Scalar(255, 255, 255));
-    cv::putText(strip, plot.y_label, {3, extent.height + 3}, font, 0.5, black, 1, cv::LINE_AA);
+    cv::putText(strip, plot_.y_label, {3, extent.height + 3}, kFont, 0.5, kBlack, 1, cv::LINE_AA);
     cv::Mat rotated;
     cv::rotate(strip, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
     const int x0 = 8;
-    const int y0 = std::max(0, (frame_top + frame_bottom) / 2 - rotated.rows / 2);
-    if (x0 + rotated.cols <= image.cols && y0 + rotated.rows <= image.rows) {
-      rotated.copyTo(image(cv::Rect(x0, y0, rotated.cols, rotated.rows)));
+    const int y0 = std::max(0, (frame_top_ + frame_bottom_) / 2 - rotated.rows / 2);
+    if (x0 + rotated.cols <= image_.cols && y0 + rotated.rows <= image_.rows) {
+      rotated.copyTo(image_(cv::Rect(x0, y0, rotated.cols, rotated.rows)));
     }
   }
+
   // Legend: a white box in the top-right corner, sized to its longest label, drawn over the data.
-  int label_width = 0;
-  const auto widen = [&](const std::string& label) {
-    int baseline = 0;
-    label_width = std::max(label_width, cv::getTextSize(label, font, 0.45, 1, &baseline).width);
-  };
-  for (const PlotSeries& s : plot.series) widen(s.label);
-  for (const PlotMarker& m : plot.markers) widen(m.label);
-  const int rows = static_cast<int>(plot.series.size() + plot.markers.size());
-  const int box_width = label_width + 56;
-  const int box_height = 20 * rows + 8;
-  const cv::Rect box(frame_right - box_width - 8, frame_top + 8, box_width, box_height);
-  cv::rectangle(image, box, cv::Scalar(255, 255, 255), cv::FILLED);
-  cv::rectangle(image, box, cv::Scalar(150, 150, 150), 1);
-  int legend_y = box.y + 20;
-  for (const PlotSeries& s : plot.series) {
-    const int x = box.x + 8;
-    cv::line(image, {x, legend_y - 4}, {x + 30, legend_y - 4}, bgr(s.red, s.green, s.blue), 3,
-             cv::LINE_AA);
-    put_text(s.label, {x + 38, legend_y}, 0.45, -1);
-    legend_y += 20;
+  void draw_legend() {
+    int label_width = 0;
+    const auto widen = [&](const std::string& label) {
+      int baseline = 0;
+      label_width = std::max(label_width, cv::getTextSize(label, kFont, 0.45, 1, &baseline).width);
+    };
+    for (const PlotSeries& s : plot_.series) widen(s.label);
+    for (const PlotMarker& m : plot_.markers) widen(m.label);
+    const int rows = static_cast<int>(plot_.series.size() + plot_.markers.size());
+    const int box_width = label_width + 56;
+    const int box_height = 20 * rows + 8;
+    const cv::Rect box(frame_right_ - box_width - 8, frame_top_ + 8, box_width, box_height);
+    cv::rectangle(image_, box, cv::Scalar(255, 255, 255), cv::FILLED);
+    cv::rectangle(image_, box, cv::Scalar(150, 150, 150), 1);
+    int legend_y = box.y + 20;
+    for (const PlotSeries& s : plot_.series) {
+      const int x = box.x + 8;
+      cv::line(image_, {x, legend_y - 4}, {x + 30, legend_y - 4}, bgr(s.red, s.green, s.blue), 3,
+               cv::LINE_AA);
+      put_text(s.label, {x + 38, legend_y}, 0.45, -1);
+      legend_y += 20;
+    }
+    for (const PlotMarker& m : plot_.markers) {
+      const int x = box.x + 8;
+      draw_marker(m, {x + 15, legend_y - 4});
+      put_text(m.label, {x + 38, legend_y}, 0.45, -1);
+      legend_y += 20;
+    }
   }
-  for (const PlotMarker& m : plot.markers) {
-    const int x = box.x + 8;
-    draw_marker(m, {x + 15, legend_y - 4});
-    put_text(m.label, {x + 38, legend_y}, 0.45, -1);
-    legend_y += 20;
-  }
-  return image;
-}
+
+  inline static const cv::Scalar kBlack{0, 0, 0};
+  const LinePlot& plot_;
+  const Layout L_;
+  cv::Mat image_;
+  const int frame_left_, frame_top_, frame_right_, frame_bottom_;
+};
+
+cv::Mat render_png(const LinePlot& plot) { return PngPlot(plot).draw(); }
 
 // Degrees made continuous: a jump of more than 180 between neighbours is a wrap, not a turn.
 std::vector<double> unwrap_degrees(std::vector<double> values) {

@@ -111,106 +111,122 @@ void DynamicPointSearch::test_cell(int cell, std::span<const Eigen::Vector2f> po
 void DynamicPointSearch::grow_community(std::span<const Eigen::Vector2f> points,
                                         const PointPredicate& is_dynamic) {
   ++result_.communities;
-  const float band = params_.band_width_px;
-  const float half_cell = cell_size_ / 2.0f;
   for (int round = 0; round < params_.max_band_rounds; ++round) {
     ++result_.band_rounds;
     const int tested_before = result_.tested_count;
-    // The hull of (previous hull vertices + new finds) is the hull of every find so far, so the
-    // community is reduced to its hull vertices each round: sorting stays cheap.
-    convex_hull(community_, hull_scratch_, hull_);
-    community_.assign(hull_.begin(), hull_.end());
-    // Band membership: distance to the hull <= dZ. For a proper polygon the test is "every edge
-    // line is within dZ" (the outward offset with mitred corners, a slightly larger band near
-    // vertices): one dot product per edge with an early exit, instead of point-segment distances.
-    const bool polygon = hull_.size() >= 3;
-    edges_.clear();
-    if (polygon) {
-      for (size_t i = 0; i < hull_.size(); ++i) {
-        const Eigen::Vector2f d = hull_[(i + 1) % hull_.size()] - hull_[i];
-        const Eigen::Vector2f outward = Eigen::Vector2f(d.y(), -d.x()).normalized();
-        edges_.emplace_back(outward.x(), outward.y(), outward.dot(hull_[i]) + band,
-                            half_cell * (std::abs(outward.x()) + std::abs(outward.y())));
-      }
-    }
-    const auto in_band = [&](const Eigen::Vector2f& p) {
-      if (!polygon) return distance_to_convex_hull(hull_, p) <= band;
-      for (const Eigen::Vector4f& e : edges_) {
-        if (e.x() * p.x() + e.y() * p.y() > e.z()) return false;
-      }
-      return true;
-    };
-    const auto anywhere = [](const Eigen::Vector2f&) { return true; };
-    Eigen::Vector2f lo = hull_[0], hi = hull_[0];
-    for (const Eigen::Vector2f& v : hull_) {
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    lo.array() -= band;
-    hi.array() += band;
-    const int col0 = std::clamp(static_cast<int>(lo.x() / cell_size_), 0, grid_cols_ - 1);
-    const int col1 = std::clamp(static_cast<int>(hi.x() / cell_size_), 0, grid_cols_ - 1);
-    const int row0 = std::clamp(static_cast<int>(lo.y() / cell_size_), 0, grid_rows_ - 1);
-    const int row1 = std::clamp(static_cast<int>(hi.y() / cell_size_), 0, grid_rows_ - 1);
-    const float half_diagonal = half_cell * std::sqrt(2.0f);
+    const bool polygon = reduce_to_hull();
     found_.clear();
-    // The band is every untested point within dZ of the hull, interior included: points the hull
-    // swallowed in one jump would otherwise never be tested. Whole grid cells are classified
-    // first (outside / inside / crossing the band's edge), so only the points of crossing cells
-    // are tested against the band one by one, and exhausted cells cost one counter look-up.
-    for (int row = row0; row <= row1; ++row) {
-      // The band is convex, so its cells in this row form one run: clip the row's x-range by
-      // every edge's half-plane (loosest over the row's height; crossing cells are exact below).
-      int first = col0, last = col1;
-      if (polygon) {
-        const float y0 = row * cell_size_, y1 = y0 + cell_size_;
-        float x_lo = lo.x(), x_hi = hi.x();
-        for (const Eigen::Vector4f& e : edges_) {
-          const float slack = e.z() - std::min(e.y() * y0, e.y() * y1);
-          if (std::abs(e.x()) < 1e-6f) {
-            if (slack < 0.0f) x_lo = x_hi + 1.0f;  // the whole row is beyond this edge
-          } else if (e.x() > 0.0f) {
-            x_hi = std::min(x_hi, slack / e.x());
-          } else {
-            x_lo = std::max(x_lo, slack / e.x());
-          }
-        }
-        if (x_lo > x_hi) continue;
-        first = std::max(col0, static_cast<int>(x_lo / cell_size_));
-        last = std::min(col1, static_cast<int>(x_hi / cell_size_));
-      }
-      for (int col = first; col <= last; ++col) {
-        const int cell = row * grid_cols_ + col;
-        if (cell_untested_[cell] == 0) continue;
-        const Eigen::Vector2f centre((col + 0.5f) * cell_size_, (row + 0.5f) * cell_size_);
-        bool inside = true, outside = false;
-        if (polygon) {
-          for (const Eigen::Vector4f& e : edges_) {
-            const float excess = e.x() * centre.x() + e.y() * centre.y() - e.z();
-            if (excess > e.w()) {
-              outside = true;
-              break;
-            }
-            if (excess > -e.w()) inside = false;
-          }
-        } else {
-          const float d = distance_to_convex_hull(hull_, centre);
-          outside = d - half_diagonal > band;
-          inside = d + half_diagonal <= band;
-        }
-        if (outside) continue;
-        if (inside)
-          test_cell(cell, points, is_dynamic, anywhere);
-        else
-          test_cell(cell, points, is_dynamic, in_band);
-      }
-    }
+    test_band(points, is_dynamic, polygon);
     if (found_.empty()) {  // a band without new dynamic points ends this community
       result_.last_band_tests += result_.tested_count - tested_before;
       return;
     }
     for (int index : found_) community_.push_back(points[index]);
   }
+}
+
+bool DynamicPointSearch::reduce_to_hull() {
+  const float band = params_.band_width_px;
+  const float half_cell = cell_size_ / 2.0f;
+  // The hull of (previous hull vertices + new finds) is the hull of every find so far, so the
+  // community is reduced to its hull vertices each round: sorting stays cheap.
+  convex_hull(community_, hull_scratch_, hull_);
+  community_.assign(hull_.begin(), hull_.end());
+  // Band membership: distance to the hull <= dZ. For a proper polygon the test is "every edge
+  // line is within dZ" (the outward offset with mitred corners, a slightly larger band near
+  // vertices): one dot product per edge with an early exit, instead of point-segment distances.
+  const bool polygon = hull_.size() >= 3;
+  edges_.clear();
+  if (polygon) {
+    for (size_t i = 0; i < hull_.size(); ++i) {
+      const Eigen::Vector2f d = hull_[(i + 1) % hull_.size()] - hull_[i];
+      const Eigen::Vector2f outward = Eigen::Vector2f(d.y(), -d.x()).normalized();
+      edges_.emplace_back(outward.x(), outward.y(), outward.dot(hull_[i]) + band,
+                          half_cell * (std::abs(outward.x()) + std::abs(outward.y())));
+    }
+  }
+  return polygon;
+}
+
+void DynamicPointSearch::test_band(std::span<const Eigen::Vector2f> points,
+                                   const PointPredicate& is_dynamic, bool polygon) {
+  const float band = params_.band_width_px;
+  const auto in_band = [&](const Eigen::Vector2f& p) {
+    if (!polygon) return distance_to_convex_hull(hull_, p) <= band;
+    for (const Eigen::Vector4f& e : edges_) {
+      if (e.x() * p.x() + e.y() * p.y() > e.z()) return false;
+    }
+    return true;
+  };
+  const auto anywhere = [](const Eigen::Vector2f&) { return true; };
+  Eigen::Vector2f lo = hull_[0], hi = hull_[0];
+  for (const Eigen::Vector2f& v : hull_) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  lo.array() -= band;
+  hi.array() += band;
+  const int col0 = std::clamp(static_cast<int>(lo.x() / cell_size_), 0, grid_cols_ - 1);
+  const int col1 = std::clamp(static_cast<int>(hi.x() / cell_size_), 0, grid_cols_ - 1);
+  const int row0 = std::clamp(static_cast<int>(lo.y() / cell_size_), 0, grid_rows_ - 1);
+  const int row1 = std::clamp(static_cast<int>(hi.y() / cell_size_), 0, grid_rows_ - 1);
+  // The band is every untested point within dZ of the hull, interior included: points the hull
+  // swallowed in one jump would otherwise never be tested. Whole grid cells are classified
+  // first (outside / inside / crossing the band's edge), so only the points of crossing cells
+  // are tested against the band one by one, and exhausted cells cost one counter look-up.
+  for (int row = row0; row <= row1; ++row) {
+    int first = col0, last = col1;
+    if (polygon && !clip_row(row, lo.x(), hi.x(), first, last)) continue;
+    for (int col = first; col <= last; ++col) {
+      const int cell = row * grid_cols_ + col;
+      if (cell_untested_[cell] == 0) continue;
+      const CellInBand place = classify_cell(col, row, polygon);
+      if (place == CellInBand::outside) continue;
+      if (place == CellInBand::inside)
+        test_cell(cell, points, is_dynamic, anywhere);
+      else
+        test_cell(cell, points, is_dynamic, in_band);
+    }
+  }
+}
+
+// The band is convex, so its cells in a row form one run: clip the row's x-range by every
+// edge's half-plane (loosest over the row's height; crossing cells are exact in test_band).
+bool DynamicPointSearch::clip_row(int row, float x_lo, float x_hi, int& first, int& last) const {
+  const float y0 = row * cell_size_, y1 = y0 + cell_size_;
+  for (const Eigen::Vector4f& e : edges_) {
+    const float slack = e.z() - std::min(e.y() * y0, e.y() * y1);
+    if (std::abs(e.x()) < 1e-6f) {
+      if (slack < 0.0f) x_lo = x_hi + 1.0f;  // the whole row is beyond this edge
+    } else if (e.x() > 0.0f) {
+      x_hi = std::min(x_hi, slack / e.x());
+    } else {
+      x_lo = std::max(x_lo, slack / e.x());
+    }
+  }
+  if (x_lo > x_hi) return false;
+  first = std::max(first, static_cast<int>(x_lo / cell_size_));
+  last = std::min(last, static_cast<int>(x_hi / cell_size_));
+  return true;
+}
+
+DynamicPointSearch::CellInBand DynamicPointSearch::classify_cell(int col, int row,
+                                                                 bool polygon) const {
+  const float band = params_.band_width_px;
+  const Eigen::Vector2f centre((col + 0.5f) * cell_size_, (row + 0.5f) * cell_size_);
+  if (!polygon) {
+    const float half_diagonal = cell_size_ / 2.0f * std::sqrt(2.0f);
+    const float d = distance_to_convex_hull(hull_, centre);
+    if (d - half_diagonal > band) return CellInBand::outside;
+    return d + half_diagonal <= band ? CellInBand::inside : CellInBand::crossing;
+  }
+  bool inside = true;
+  for (const Eigen::Vector4f& e : edges_) {
+    const float excess = e.x() * centre.x() + e.y() * centre.y() - e.z();
+    if (excess > e.w()) return CellInBand::outside;
+    if (excess > -e.w()) inside = false;
+  }
+  return inside ? CellInBand::inside : CellInBand::crossing;
 }
 
 const SearchResult& DynamicPointSearch::run(std::span<const Eigen::Vector2f> points,

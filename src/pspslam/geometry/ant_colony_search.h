@@ -86,6 +86,17 @@ class DynamicPointSearch {
                  const PointPredicate& is_dynamic, const InBand& in_band);
   // Grows the community whose first dynamic points are in community_ until a band adds nothing.
   void grow_community(std::span<const Eigen::Vector2f> points, const PointPredicate& is_dynamic);
+  // Reduces community_ to its convex hull and lays out the band's edges_; true when the hull is
+  // a polygon (else the band is measured by distance to the hull).
+  bool reduce_to_hull();
+  // Tests the untested points in the band around the hull; the dynamic ones go to found_.
+  void test_band(std::span<const Eigen::Vector2f> points, const PointPredicate& is_dynamic,
+                 bool polygon);
+  // Narrows [first, last] to the grid columns of `row` the band can reach (x_lo, x_hi: the
+  // band's bounding box); false when it reaches none.
+  bool clip_row(int row, float x_lo, float x_hi, int& first, int& last) const;
+  enum class CellInBand { outside, inside, crossing };
+  CellInBand classify_cell(int col, int row, bool polygon) const;
 
   AntColonyParams params_;
   SearchResult result_;

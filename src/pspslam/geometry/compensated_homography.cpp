@@ -178,6 +178,50 @@ int refine_levenberg_marquardt(std::span<const Eigen::Vector2d> x,
   return iteration;
 }
 
+// Three of the four points (in either image) on a line: no homography through them.
+bool degenerate_sample(const std::array<Eigen::Vector2d, 4>& sample_x,
+                       const std::array<Eigen::Vector2d, 4>& sample_y) {
+  bool degenerate = false;
+  for (int a = 0; a < 4 && !degenerate; ++a) {
+    const int b = (a + 1) % 4, c = (a + 2) % 4;
+    degenerate = std::abs(triangle_area2(sample_x[a], sample_x[b], sample_x[c])) < 1e-3 ||
+                 std::abs(triangle_area2(sample_y[a], sample_y[b], sample_y[c])) < 1e-3;
+  }
+  return degenerate;
+}
+
+// MSAC score of H (sum of squared transfer errors truncated at threshold2) and its inliers;
+// stops adding once the score reaches `give_up_at` (it cannot be the best then).
+double msac_score(const Eigen::Matrix3d& H, std::span<const Eigen::Vector2d> previous,
+                  std::span<const Eigen::Vector2d> current, double threshold2, double give_up_at,
+                  int& inliers) {
+  double score = 0.0;
+  inliers = 0;
+  for (size_t i = 0; i < previous.size() && score < give_up_at; ++i) {
+    const double e2 = squared_transfer_error(H, previous[i], current[i]);
+    if (e2 < threshold2) {
+      score += e2;
+      ++inliers;
+    } else {
+      score += threshold2;
+    }
+  }
+  return score;
+}
+
+// The RANSAC iterations that reach the confidence with the new best model's inlier ratio.
+int iterations_needed(int inliers, size_t n, int iteration, int needed_iterations,
+                      const HomographyParams& params) {
+  const double inlier_ratio = static_cast<double>(inliers) / static_cast<double>(n);
+  const double all_inlier_sample = std::pow(inlier_ratio, 4);
+  if (all_inlier_sample > 1.0 - 1e-12) return iteration + 1;
+  if (all_inlier_sample > 0.0) {
+    const double k = std::log(1.0 - params.ransac_confidence) / std::log(1.0 - all_inlier_sample);
+    return std::min(params.max_ransac_iterations, static_cast<int>(std::ceil(k)));
+  }
+  return needed_iterations;
+}
+
 }  // namespace
 
 HomographyParams HomographyParams::from_yaml(YamlSection& section) {
@@ -229,39 +273,16 @@ CompensatedHomography estimate_compensated_homography(std::span<const Eigen::Vec
       sample_x[k] = previous[index[k]];
       sample_y[k] = current[index[k]];
     }
-    bool degenerate = false;
-    for (int a = 0; a < 4 && !degenerate; ++a) {
-      const int b = (a + 1) % 4, c = (a + 2) % 4;
-      degenerate = std::abs(triangle_area2(sample_x[a], sample_x[b], sample_x[c])) < 1e-3 ||
-                   std::abs(triangle_area2(sample_y[a], sample_y[b], sample_y[c])) < 1e-3;
-    }
-    if (degenerate) continue;
+    if (degenerate_sample(sample_x, sample_y)) continue;
     Eigen::Matrix3d H;
     if (!solve_minimal(sample_x, sample_y, H)) continue;
-    double score = 0.0;
     int inliers = 0;
-    for (size_t i = 0; i < n && score < best_score; ++i) {
-      const double e2 = squared_transfer_error(H, previous[i], current[i]);
-      if (e2 < threshold2) {
-        score += e2;
-        ++inliers;
-      } else {
-        score += threshold2;
-      }
-    }
+    const double score = msac_score(H, previous, current, threshold2, best_score, inliers);
     if (score < best_score) {
       best_score = score;
       best_inliers = inliers;
       result.H_ransac = H;
-      const double inlier_ratio = static_cast<double>(inliers) / static_cast<double>(n);
-      const double all_inlier_sample = std::pow(inlier_ratio, 4);
-      if (all_inlier_sample > 1.0 - 1e-12) {
-        needed_iterations = iteration + 1;
-      } else if (all_inlier_sample > 0.0) {
-        const double k =
-            std::log(1.0 - params.ransac_confidence) / std::log(1.0 - all_inlier_sample);
-        needed_iterations = std::min(params.max_ransac_iterations, static_cast<int>(std::ceil(k)));
-      }
+      needed_iterations = iterations_needed(inliers, n, iteration, needed_iterations, params);
     }
   }
   result.ransac_iterations = iteration;

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <functional>
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/core/clock.h"
 #include "pspslam/core/error.h"
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/core/yaml_section.h"
 
 namespace pspslam {
@@ -22,11 +22,6 @@ struct Stopwatch {
   std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
   double cpu = thread_cpu_ms();
 
-  static double thread_cpu_ms() {
-    timespec now{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-    return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
-  }
   double wall_ms() const { return milliseconds_since(wall); }
   double cpu_ms() const { return thread_cpu_ms() - cpu; }
 };
@@ -81,51 +76,79 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
                 " keypoint depths for " + std::to_string(input.keypoints.size()) + " keypoints");
   }
   GeometryFrameResult result;
+  const std::optional<Eigen::Matrix3d> previous_to_current = compensate_motion(input, result);
+  result.timing.homography_ms = start.wall_ms();
+  result.timing.homography_cpu_ms = start.cpu_ms();
+  prepare_candidates(input, previous_to_current);
 
-  // III.B: camera-motion compensation of the previous frame (eq. 10-11).
+  const Stopwatch selection_start;
+  const std::span<const DepthView> references = select_references(input);
+  result.references_used = static_cast<int>(references.size());
+  result.timing.selection_ms = selection_start.wall_ms();
+  result.timing.selection_cpu_ms = selection_start.cpu_ms();
+
+  // III.C: reverse ant-colony search driving the multi-view test.
+  const Stopwatch search_start;
+  test_.set_frame(input.T_world_camera, references);
+  const SearchResult& search = search_.run(
+      points_, input.depth.size(),
+      [&](int index) {
+        depth_of(input, static_cast<size_t>(index));
+        return test_.is_dynamic(candidates_[index]);
+      },
+      priority_);
+  result.timing.search_ms = search_start.wall_ms();
+  result.timing.search_cpu_ms = search_start.cpu_ms();
+
+  const Stopwatch region_start;
+  grow_regions(input, search, result.dynamic_mask);
+  result.timing.region_ms = region_start.wall_ms();
+  result.timing.region_cpu_ms = region_start.cpu_ms();
+
+  mark_dynamic_keypoints(search, result);
+  result.timing.total_ms = start.wall_ms();
+  result.timing.total_cpu_ms = start.cpu_ms();
+  return result;
+}
+
+// III.B: camera-motion compensation of the previous frame (eq. 10-11).
+std::optional<Eigen::Matrix3d> GeometryStage::compensate_motion(const GeometryFrameInput& input,
+                                                                GeometryFrameResult& result) {
   const cv::Mat& previous_mask = input.previous_dynamic_mask;
-  const bool have_previous_mask = !previous_mask.empty() && previous_mask.type() == CV_8UC1;
   std::optional<Eigen::Matrix3d> previous_to_current = input.H_previous_to_current;
   if (!previous_to_current && input.matched_previous.size() >= 4) {
     result.homography = estimate_compensated_homography(input.matched_previous,
                                                         input.matched_current, params_.homography);
     if (result.homography.valid) previous_to_current = result.homography.H;
   }
-  const Eigen::Matrix3d current_to_previous = previous_to_current
-                                                  ? Eigen::Matrix3d(previous_to_current->inverse())
-                                                  : Eigen::Matrix3d::Identity();
-  if (have_previous_mask && params_.output_warped_previous_mask) {
+  if (has_previous_mask(input) && params_.output_warped_previous_mask) {
     result.warped_previous_mask =
         previous_to_current
             ? warp_to_current(previous_mask, *previous_to_current, input.depth.size(), true)
             : previous_mask.clone();
   }
-  result.timing.homography_ms = start.wall_ms();
-  result.timing.homography_cpu_ms = start.cpu_ms();
+  return previous_to_current;
+}
 
-  // Candidates. Work per point that only a tested point needs (its depth: a read at a random
-  // place of the depth image when the caller gives none) is done lazily in depth_of(), so the
-  // ant colony pays it only for the points it tests; the exhaustive baseline pays it for all.
+bool GeometryStage::has_previous_mask(const GeometryFrameInput& input) {
+  return !input.previous_dynamic_mask.empty() && input.previous_dynamic_mask.type() == CV_8UC1;
+}
+
+// Candidates. Work per point that only a tested point needs (its depth: a read at a random
+// place of the depth image when the caller gives none) is done lazily in depth_of(), so the
+// ant colony pays it only for the points it tests; the exhaustive baseline pays it for all.
+void GeometryStage::prepare_candidates(const GeometryFrameInput& input,
+                                       const std::optional<Eigen::Matrix3d>& previous_to_current) {
+  const cv::Mat& previous_mask = input.previous_dynamic_mask;
+  const Eigen::Matrix3d current_to_previous = previous_to_current
+                                                  ? Eigen::Matrix3d(previous_to_current->inverse())
+                                                  : Eigen::Matrix3d::Identity();
   const size_t n = input.keypoints.size();
   points_.resize(n);
   candidates_.resize(n);
   priority_.clear();
-  const auto depth_of = [&](size_t i) {
-    double& depth = candidates_[i].depth;
-    if (depth != kDepthNotRead) return depth;
-    depth = 0.0;
-    if (!input.keypoint_depths.empty()) {
-      depth = input.keypoint_depths[i];
-    } else {
-      const int u = static_cast<int>(std::lround(candidates_[i].pixel.x()));
-      const int v = static_cast<int>(std::lround(candidates_[i].pixel.y()));
-      if (u >= 0 && v >= 0 && u < input.depth.cols && v < input.depth.rows)
-        depth = input.depth.ptr<float>(v)[u];
-    }
-    return depth;
-  };
   // Only the ant colony uses the priority points (the exhaustive baseline tests every point).
-  const bool use_prior = params_.previous_mask_prior && have_previous_mask &&
+  const bool use_prior = params_.previous_mask_prior && has_previous_mask(input) &&
                          params_.search.strategy == SearchStrategy::ant_colony;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& pixel = input.keypoints[i];
@@ -143,58 +166,64 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
         priority_.push_back(static_cast<int>(i));
     }
   }
+}
 
-  // Reference views: the most covering ones of a larger pool (DynaSLAM: most overlapping).
-  // The test gets them oldest first (the pool is ordered newest first): a mover has had the most
-  // time to leave its place in the oldest view, so that view most often gives the dynamic vote
-  // that ends the test of a dynamic point early. The verdict does not depend on the order.
-  const Stopwatch selection_start;
+double GeometryStage::depth_of(const GeometryFrameInput& input, size_t i) {
+  double& depth = candidates_[i].depth;
+  if (depth != kDepthNotRead) return depth;
+  depth = 0.0;
+  if (!input.keypoint_depths.empty()) {
+    depth = input.keypoint_depths[i];
+  } else {
+    const int u = static_cast<int>(std::lround(candidates_[i].pixel.x()));
+    const int v = static_cast<int>(std::lround(candidates_[i].pixel.y()));
+    if (u >= 0 && v >= 0 && u < input.depth.cols && v < input.depth.rows)
+      depth = input.depth.ptr<float>(v)[u];
+  }
+  return depth;
+}
+
+// Reference views: the most covering ones of a larger pool (DynaSLAM: most overlapping).
+// The test gets them oldest first (the pool is ordered newest first): a mover has had the most
+// time to leave its place in the oldest view, so that view most often gives the dynamic vote
+// that ends the test of a dynamic point early. The verdict does not depend on the order.
+std::span<const DepthView> GeometryStage::select_references(const GeometryFrameInput& input) {
   selected_references_.clear();
   if (input.references.size() > static_cast<size_t>(params_.multiview.max_reference_views)) {
     // The selector estimates coverage on every point_stride-th candidate: only those need depths.
-    for (size_t i = 0; i < n; i += static_cast<size_t>(params_.references.point_stride))
-      depth_of(i);
+    for (size_t i = 0; i < candidates_.size();
+         i += static_cast<size_t>(params_.references.point_stride))
+      depth_of(input, i);
     selected_pool_indices_ = selector_.select(input.T_world_camera, candidates_, input.references);
     std::sort(selected_pool_indices_.begin(), selected_pool_indices_.end(), std::greater<>());
     for (int v : selected_pool_indices_) selected_references_.push_back(input.references[v]);
   } else {
     selected_references_.assign(input.references.rbegin(), input.references.rend());
   }
-  const std::span<const DepthView> references = selected_references_;
-  result.references_used = static_cast<int>(references.size());
-  result.timing.selection_ms = selection_start.wall_ms();
-  result.timing.selection_cpu_ms = selection_start.cpu_ms();
+  return selected_references_;
+}
 
-  // III.C: reverse ant-colony search driving the multi-view test.
-  const Stopwatch search_start;
-  test_.set_frame(input.T_world_camera, references);
-  const SearchResult& search = search_.run(
-      points_, input.depth.size(),
-      [&](int index) {
-        depth_of(static_cast<size_t>(index));
-        return test_.is_dynamic(candidates_[index]);
-      },
-      priority_);
-  result.timing.search_ms = search_start.wall_ms();
-  result.timing.search_cpu_ms = search_start.cpu_ms();
-
-  // Region growing from the dynamic points; verified-static points may act as barriers.
-  const Stopwatch region_start;
+// Region growing from the dynamic points; verified-static points may act as barriers.
+void GeometryStage::grow_regions(const GeometryFrameInput& input, const SearchResult& search,
+                                 cv::Mat& mask) {
   seeds_.clear();
   seed_depths_.clear();
   static_points_.clear();
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < points_.size(); ++i) {
     if (search.dynamic[i]) {
       seeds_.push_back(points_[i]);
-      seed_depths_.push_back(static_cast<float>(depth_of(i)));
+      seed_depths_.push_back(static_cast<float>(depth_of(input, i)));
     } else if (search.tested[i]) {
       static_points_.push_back(points_[i]);
     }
   }
-  grower_.grow(input.depth, seeds_, seed_depths_, static_points_, result.dynamic_mask);
-  result.timing.region_ms = region_start.wall_ms();
-  result.timing.region_cpu_ms = region_start.cpu_ms();
+  grower_.grow(input.depth, seeds_, seed_depths_, static_points_, mask);
+}
 
+// A keypoint is dynamic when the test found it so or it lies in the grown mask.
+void GeometryStage::mark_dynamic_keypoints(const SearchResult& search,
+                                           GeometryFrameResult& result) const {
+  const size_t n = points_.size();
   result.keypoint_tested = search.tested;
   result.keypoint_tested_dynamic = search.dynamic;
   result.keypoint_dynamic.assign(n, 0);
@@ -208,9 +237,6 @@ GeometryFrameResult GeometryStage::process(const GeometryFrameInput& input) {
     result.keypoint_dynamic[i] = search.dynamic[i] || in_mask;
     result.dynamic_count += result.keypoint_dynamic[i];
   }
-  result.timing.total_ms = start.wall_ms();
-  result.timing.total_cpu_ms = start.cpu_ms();
-  return result;
 }
 
 cv::Mat fuse_dynamic_masks(const cv::Mat& semantic_mask, const cv::Mat& geometry_mask,

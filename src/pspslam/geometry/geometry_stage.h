@@ -113,6 +113,20 @@ class GeometryStage {
   std::span<const Eigen::Vector2f> last_search_path() const { return search_.last_path(); }
 
  private:
+  // The homography previous -> current (the caller's, else estimated from the matches) and the
+  // warped previous mask when asked for.
+  std::optional<Eigen::Matrix3d> compensate_motion(const GeometryFrameInput& input,
+                                                   GeometryFrameResult& result);
+  static bool has_previous_mask(const GeometryFrameInput& input);
+  // points_, candidates_ (depths not read yet) and the priority points inside the previous mask.
+  void prepare_candidates(const GeometryFrameInput& input,
+                          const std::optional<Eigen::Matrix3d>& previous_to_current);
+  // Candidate i's depth, read on first use.
+  double depth_of(const GeometryFrameInput& input, size_t i);
+  std::span<const DepthView> select_references(const GeometryFrameInput& input);
+  void grow_regions(const GeometryFrameInput& input, const SearchResult& search, cv::Mat& mask);
+  void mark_dynamic_keypoints(const SearchResult& search, GeometryFrameResult& result) const;
+
   PinholeCamera camera_;
   GeometryParams params_;
   MultiViewTest test_;

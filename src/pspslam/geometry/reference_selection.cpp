@@ -57,6 +57,13 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
       if (!pool[v].depth.empty()) chosen_.push_back(v);
     return chosen_;
   }
+  sample_candidates(points);
+  mark_seen(T_world_current, pool);
+  pick_views(pool);
+  return chosen_;
+}
+
+void ReferenceSelector::sample_candidates(std::span<const CandidatePoint> points) {
   // Back-project the sampled candidates once; each view then only transforms and projects.
   const size_t stride = static_cast<size_t>(std::max(1, params_.point_stride));
   sampled_.clear();
@@ -67,6 +74,12 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
       sampled_norms_.push_back(sampled_.back().norm());
     }
   }
+}
+
+// Per view and sampled candidate: the view sees it (in front, inside the border, on a depth
+// reading, within the parallax limit).
+void ReferenceSelector::mark_seen(const Pose& T_world_current, std::span<const DepthView> pool) {
+  const int views = static_cast<int>(pool.size());
   const size_t sampled = sampled_.size();
   seen_.assign(static_cast<size_t>(views) * sampled, 0);
   const double cos_max_parallax = std::cos(params_.max_parallax_deg * M_PI / 180.0);
@@ -100,7 +113,11 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
   }
   // Views that left the pool leave the cache (and release their depth images).
   std::erase_if(cache_, [](const CachedView& view) { return !view.used; });
+}
 
+void ReferenceSelector::pick_views(std::span<const DepthView> pool) {
+  const int views = static_cast<int>(pool.size());
+  const size_t sampled = sampled_.size();
   coverage_.assign(sampled, 0);
   picked_.assign(static_cast<size_t>(views), 0);
   gains_.assign(static_cast<size_t>(views), 0);
@@ -135,7 +152,6 @@ const std::vector<int>& ReferenceSelector::select(const Pose& T_world_current,
     const std::uint8_t* seen = seen_.data() + static_cast<size_t>(choice) * sampled;
     for (size_t s = 0; s < sampled; ++s) coverage_[s] += seen[s];
   }
-  return chosen_;
 }
 
 }  // namespace pspslam

@@ -60,6 +60,11 @@ class ReferenceSelector {
     bool used = false;
   };
   const BlockValidity& validity(const cv::Mat& depth);
+  // Back-projects every point_stride-th candidate with a depth into sampled_.
+  void sample_candidates(std::span<const CandidatePoint> points);
+  void mark_seen(const Pose& T_world_current, std::span<const DepthView> pool);
+  // Greedy picks of the views that add the most coverage, into chosen_.
+  void pick_views(std::span<const DepthView> pool);
 
   PinholeCamera camera_;
   Params params_;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <span>
 #include <utility>
@@ -64,6 +65,32 @@ class DynamicRegionGrower {
   const RegionGrowParams& params() const { return params_; }
 
  private:
+  // Grid cells in a bounding box.
+  struct GridBox {
+    int min_x, max_x, min_y, max_y;
+    void add(int x, int y) {
+      min_x = std::min(min_x, x);
+      max_x = std::max(max_x, x);
+      min_y = std::min(min_y, y);
+      max_y = std::max(max_y, y);
+    }
+  };
+  // The grid cell a seed starts on (x < 0: none) and its depth's distance from the seed's.
+  struct StartCell {
+    int x, y;
+    float gap;
+  };
+
+  // Lays the grid out for `depth`, unclaims the cells of the last call and marks the barriers.
+  void reset_grid(const cv::Mat& depth, std::span<const Eigen::Vector2f> static_points);
+  // Grid row `gy`, sampled from `depth` the first time it is asked for.
+  const float* sampled_row(const cv::Mat& depth, int gy);
+  StartCell start_cell(const cv::Mat& depth, const Eigen::Vector2f& seed, float wanted);
+  // Grows a new region from grid cell (sx, sy), widening `grown` by its cells.
+  void grow_region(const cv::Mat& depth, int sx, int sy, GridBox& grown);
+  // Paints the supported regions into `mask` at full resolution.
+  void fill_mask(const cv::Mat& depth, const GridBox& grown, cv::Mat& mask);
+
   RegionGrowParams params_;
   float focal_length_px_ = 0.0f;
   cv::Mat grid_depth_;                     // CV_32F, one sample per block, read a row at a time

@@ -54,6 +54,131 @@ std::vector<PointPair> point_pairs(const KeyFrame& current, const KeyFrame& cand
   return pairs;
 }
 
+// 1. RANSAC on 3D-3D pairs (each map point in its own keyframe's camera). Matches outside its
+// consensus are dropped.
+std::optional<Sim3> ransac_alignment(const KeyFrame& current, const KeyFrame& candidate,
+                                     std::vector<std::shared_ptr<MapPoint>>& matched,
+                                     const LoopDetectorOptions& options) {
+  const std::vector<PointPair> pairs = point_pairs(current, candidate, matched);
+  std::vector<RigidCorrespondence> correspondences;
+  correspondences.reserve(pairs.size());
+  for (const PointPair& pair : pairs) {
+    const double z = std::max(pair.in_current.z(), pair.in_candidate.z());
+    correspondences.push_back({pair.in_candidate, pair.in_current,
+                               options.ransac_error_base + options.ransac_error_per_depth * z +
+                                   options.ransac_error_per_depth2 * z * z});
+  }
+  RigidRansacOptions ransac = options.ransac;
+  ransac.seed = current.id() * 7919 + candidate.id();
+  const RigidRansacResult estimate = solve_rigid_ransac(correspondences, ransac);
+  if (!estimate.success) return std::nullopt;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (!estimate.inlier[k]) matched[pairs[k].index] = nullptr;
+  }
+  return estimate.S_target_source;
+}
+
+// Three rounds of alignment on the pairs that reproject in both images (the role of
+// ORB-SLAM2's OptimizeSim3), with weights 1/z² (depth noise). Returns the inlier count, none
+// when too few pairs hold or an alignment fails.
+std::optional<int> align_reprojecting_pairs(const KeyFrame& current, const KeyFrame& candidate,
+                                            const std::vector<PointPair>& pairs,
+                                            const LoopDetectorOptions& options,
+                                            Sim3& S_current_candidate,
+                                            std::vector<std::uint8_t>& inlier) {
+  int inliers = 0;
+  for (int round = 0; round < 3; ++round) {
+    const Sim3 S_candidate_current = S_current_candidate.inverse();
+    inliers = 0;
+    std::vector<Eigen::Vector3d> source;
+    std::vector<Eigen::Vector3d> target;
+    std::vector<double> weights;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      const PointPair& pair = pairs[k];
+      inlier[k] = reprojects(current, pair.index, S_current_candidate * pair.in_candidate,
+                             options.reprojection_chi2) &&
+                  reprojects(candidate, pair.candidate_index, S_candidate_current * pair.in_current,
+                             options.reprojection_chi2);
+      if (!inlier[k]) continue;
+      ++inliers;
+      source.push_back(pair.in_candidate);
+      target.push_back(pair.in_current);
+      const double z = std::max(pair.in_current.z(), pair.in_candidate.z());
+      weights.push_back(1.0 / std::max(z * z, 0.01));
+    }
+    if (inliers < options.min_verified_inliers) return std::nullopt;
+    if (options.ransac.estimate_scale) {
+      const std::optional<Sim3> refined = align_similarity(source, target, weights);
+      if (!refined) return std::nullopt;
+      S_current_candidate = *refined;
+    } else {
+      const std::optional<Pose> refined = align_rigid(source, target, weights);
+      if (!refined) return std::nullopt;
+      S_current_candidate = Sim3(*refined);
+    }
+  }
+  return inliers;
+}
+
+// Refinement of the similarity on the reprojection errors of the inlier pairs in both images.
+// Returns the inlier count, none when too few remain.
+std::optional<int> refine_by_reprojection(const KeyFrame& current, const KeyFrame& candidate,
+                                          const std::vector<PointPair>& pairs,
+                                          const LoopDetectorOptions& options,
+                                          Sim3& S_current_candidate,
+                                          std::vector<std::uint8_t>& inlier) {
+  std::vector<SimilarityPair> reprojected;
+  std::vector<size_t> pair_of;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (!inlier[k]) continue;
+    const cv::KeyPoint& in_current = current.keypoints()[pairs[k].index];
+    const cv::KeyPoint& in_candidate = candidate.keypoints()[pairs[k].candidate_index];
+    reprojected.push_back({pairs[k].in_current, pairs[k].in_candidate,
+                           Eigen::Vector2d(in_current.pt.x, in_current.pt.y),
+                           Eigen::Vector2d(in_candidate.pt.x, in_candidate.pt.y),
+                           current.pyramid().inv_sigma2[in_current.octave],
+                           candidate.pyramid().inv_sigma2[in_candidate.octave]});
+    pair_of.push_back(k);
+  }
+  SimilarityOptimizationOptions refinement;
+  refinement.estimate_scale = options.ransac.estimate_scale;
+  const SimilarityOptimizationResult refined =
+      optimize_similarity(current.camera().pinhole, S_current_candidate, reprojected, refinement);
+  if (refined.num_inliers < options.min_verified_inliers) return std::nullopt;
+  S_current_candidate = refined.S_a_b;
+  for (size_t j = 0; j < pair_of.size(); ++j) inlier[pair_of[j]] = refined.inlier[j];
+  return refined.num_inliers;
+}
+
+// Keeps the matches of inlier pairs only.
+void keep_inlier_matches(const KeyFrame& current, const std::vector<PointPair>& pairs,
+                         const std::vector<std::uint8_t>& inlier,
+                         std::vector<std::shared_ptr<MapPoint>>& matched) {
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (!inlier[k]) matched[pairs[k].index] = nullptr;
+  }
+  // Matches without a point in the current keyframe are not pairs; they were never checked.
+  const auto own = current.map_points();
+  for (int i = 0; i < current.size(); ++i) {
+    if (matched[i] && !own[i]) matched[i] = nullptr;
+  }
+}
+
+// The points of the candidate and its covisible keyframes, each once.
+std::vector<std::shared_ptr<MapPoint>> neighbourhood_points(
+    const std::shared_ptr<KeyFrame>& candidate) {
+  std::vector<std::shared_ptr<MapPoint>> points;
+  std::unordered_set<const MapPoint*> seen;
+  auto neighbourhood = candidate->covisibles();
+  neighbourhood.push_back(candidate);
+  for (const auto& member : neighbourhood) {
+    for (const auto& point : member->map_points()) {
+      if (point && seen.insert(point.get()).second) points.push_back(point);
+    }
+  }
+  return points;
+}
+
 }  // namespace
 
 LoopDetector::LoopDetector(const Map& map, const PlaceRecognition& place,
@@ -156,93 +281,26 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
     return std::nullopt;
   }
 
-  // 1. RANSAC on 3D-3D pairs (each map point in its own keyframe's camera).
-  std::vector<PointPair> pairs = point_pairs(*keyframe, *candidate, matched);
-  std::vector<RigidCorrespondence> correspondences;
-  correspondences.reserve(pairs.size());
-  for (const PointPair& pair : pairs) {
-    const double z = std::max(pair.in_current.z(), pair.in_candidate.z());
-    correspondences.push_back({pair.in_candidate, pair.in_current,
-                               options_.ransac_error_base + options_.ransac_error_per_depth * z +
-                                   options_.ransac_error_per_depth2 * z * z});
-  }
-  RigidRansacOptions ransac = options_.ransac;
-  ransac.seed = keyframe->id() * 7919 + candidate->id();
-  const RigidRansacResult estimate = solve_rigid_ransac(correspondences, ransac);
-  if (!estimate.success) return std::nullopt;
-  Sim3 S_current_candidate = estimate.S_target_source;
+  // 1. RANSAC on 3D-3D pairs.
+  const std::optional<Sim3> estimate = ransac_alignment(*keyframe, *candidate, matched, options_);
+  if (!estimate) return std::nullopt;
+  Sim3 S_current_candidate = *estimate;
 
   // 2. Guided search for more pairs, then refinement on the pairs that reproject in both
   // images (the role of ORB-SLAM2's OptimizeSim3), with weights 1/z² (depth noise).
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    if (!estimate.inlier[k]) matched[pairs[k].index] = nullptr;
-  }
   match_by_transform(*keyframe, *candidate, S_current_candidate, matched, options_.guided_radius,
                      options_.matching);
-  pairs = point_pairs(*keyframe, *candidate, matched);
+  const std::vector<PointPair> pairs = point_pairs(*keyframe, *candidate, matched);
   std::vector<std::uint8_t> inlier(pairs.size(), 0);
-  int inliers = 0;
-  for (int round = 0; round < 3; ++round) {
-    const Sim3 S_candidate_current = S_current_candidate.inverse();
-    inliers = 0;
-    std::vector<Eigen::Vector3d> source;
-    std::vector<Eigen::Vector3d> target;
-    std::vector<double> weights;
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      const PointPair& pair = pairs[k];
-      inlier[k] = reprojects(*keyframe, pair.index, S_current_candidate * pair.in_candidate,
-                             options_.reprojection_chi2) &&
-                  reprojects(*candidate, pair.candidate_index,
-                             S_candidate_current * pair.in_current, options_.reprojection_chi2);
-      if (!inlier[k]) continue;
-      ++inliers;
-      source.push_back(pair.in_candidate);
-      target.push_back(pair.in_current);
-      const double z = std::max(pair.in_current.z(), pair.in_candidate.z());
-      weights.push_back(1.0 / std::max(z * z, 0.01));
-    }
-    if (inliers < options_.min_verified_inliers) return std::nullopt;
-    if (options_.ransac.estimate_scale) {
-      const std::optional<Sim3> refined = align_similarity(source, target, weights);
-      if (!refined) return std::nullopt;
-      S_current_candidate = *refined;
-    } else {
-      const std::optional<Pose> refined = align_rigid(source, target, weights);
-      if (!refined) return std::nullopt;
-      S_current_candidate = Sim3(*refined);
-    }
-  }
+  std::optional<int> inliers =
+      align_reprojecting_pairs(*keyframe, *candidate, pairs, options_, S_current_candidate, inlier);
+  if (!inliers) return std::nullopt;
   if (options_.refine_by_reprojection) {
-    std::vector<SimilarityPair> reprojected;
-    std::vector<size_t> pair_of;
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      if (!inlier[k]) continue;
-      const cv::KeyPoint& in_current = keyframe->keypoints()[pairs[k].index];
-      const cv::KeyPoint& in_candidate = candidate->keypoints()[pairs[k].candidate_index];
-      reprojected.push_back({pairs[k].in_current, pairs[k].in_candidate,
-                             Eigen::Vector2d(in_current.pt.x, in_current.pt.y),
-                             Eigen::Vector2d(in_candidate.pt.x, in_candidate.pt.y),
-                             keyframe->pyramid().inv_sigma2[in_current.octave],
-                             candidate->pyramid().inv_sigma2[in_candidate.octave]});
-      pair_of.push_back(k);
-    }
-    SimilarityOptimizationOptions refinement;
-    refinement.estimate_scale = options_.ransac.estimate_scale;
-    const SimilarityOptimizationResult refined = optimize_similarity(
-        keyframe->camera().pinhole, S_current_candidate, reprojected, refinement);
-    if (refined.num_inliers < options_.min_verified_inliers) return std::nullopt;
-    S_current_candidate = refined.S_a_b;
-    inliers = refined.num_inliers;
-    for (size_t j = 0; j < pair_of.size(); ++j) inlier[pair_of[j]] = refined.inlier[j];
+    inliers =
+        refine_by_reprojection(*keyframe, *candidate, pairs, options_, S_current_candidate, inlier);
+    if (!inliers) return std::nullopt;
   }
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    if (!inlier[k]) matched[pairs[k].index] = nullptr;
-  }
-  // Matches without a point in the current keyframe are not pairs; they were never checked.
-  const auto own = keyframe->map_points();
-  for (int i = 0; i < keyframe->size(); ++i) {
-    if (matched[i] && !own[i]) matched[i] = nullptr;
-  }
+  keep_inlier_matches(*keyframe, pairs, inlier, matched);
 
   // 3. Project the candidate's neighbourhood into the corrected current keyframe.
   DetectedLoop loop;
@@ -250,15 +308,8 @@ std::optional<DetectedLoop> LoopDetector::verify_candidate(
   loop.matched = candidate;
   loop.S_current_matched = S_current_candidate;
   loop.S_current_world = S_current_candidate * candidate->T_camera_world();
-  loop.verified_inliers = inliers;
-  std::unordered_set<const MapPoint*> seen;
-  auto neighbourhood = candidate->covisibles();
-  neighbourhood.push_back(candidate);
-  for (const auto& member : neighbourhood) {
-    for (const auto& point : member->map_points()) {
-      if (point && seen.insert(point.get()).second) loop.loop_points.push_back(point);
-    }
-  }
+  loop.verified_inliers = *inliers;
+  loop.loop_points = neighbourhood_points(candidate);
   match_by_projection(*keyframe, loop.S_current_world.rescaled_pose(), loop.loop_points, matched,
                       options_.projection_radius, options_.matching);
   loop.total_matches = static_cast<int>(

@@ -190,11 +190,9 @@ BaResult solve_bundle_adjustment(BaProblem& problem, const PinholeCamera& camera
                                    point_values[observation.point]);
   };
   const auto classify = [&](std::vector<uint8_t>& inlier) {
-    for (size_t i = 0; i < num_observations; ++i) {
-      const double threshold =
-          has_depth(problem.observations[i]) ? options.chi2_stereo : options.chi2_mono;
-      inlier[i] = chi2_of(i, poses, points) <= threshold;
-    }
+    classify_by_chi2(
+        problem.observations, options.chi2_mono, options.chi2_stereo,
+        [&](size_t i) { return chi2_of(i, poses, points); }, inlier);
   };
 
   // Stage 1 starts from everything in front of its camera (the cost is undefined behind it).

@@ -106,10 +106,7 @@ class RelativeSimilarityError {
   double rotation_weight_;
 };
 
-}  // namespace
-
-PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& options) {
-  PoseGraphResult result;
+void check_edges(const PoseGraph& graph) {
   for (size_t e = 0; e < graph.edges.size(); ++e) {
     const PoseGraphEdge& edge = graph.edges[e];
     if (edge.first >= graph.nodes.size() || edge.second >= graph.nodes.size() ||
@@ -119,27 +116,33 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
                   std::to_string(graph.nodes.size()));
     }
   }
-  if (graph.nodes.empty() || graph.edges.empty()) return result;
+}
 
-  // Each node: the rotation and translation of its similarity as a pose block, and (with
-  // optimize_scale) its log scale as a block of one.
+// Each node: the rotation and translation of its similarity as a pose block, and (with
+// optimize_scale) its log scale as a block of one.
+struct NodeBlocks {
   std::vector<PoseParameters> parameters;
   std::vector<double> log_scales;
-  parameters.reserve(graph.nodes.size());
-  log_scales.reserve(graph.nodes.size());
+};
+
+NodeBlocks node_blocks(const PoseGraph& graph) {
+  NodeBlocks blocks;
+  blocks.parameters.reserve(graph.nodes.size());
+  blocks.log_scales.reserve(graph.nodes.size());
   for (const PoseGraphNode& node : graph.nodes) {
     Pose rigid = Pose::Identity();
     rigid.linear() = node.S_camera_world.rotation;
     rigid.translation() = node.S_camera_world.translation;
-    parameters.push_back(PoseParameters::from_pose(rigid));
-    log_scales.push_back(std::log(node.S_camera_world.scale));
+    blocks.parameters.push_back(PoseParameters::from_pose(rigid));
+    blocks.log_scales.push_back(std::log(node.S_camera_world.scale));
   }
+  return blocks;
+}
 
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> manifold{
-      ceres::EigenQuaternionManifold(), ceres::EuclideanManifold<3>()};
+void add_edges(const PoseGraph& graph, const PoseGraphOptions& options, NodeBlocks& blocks,
+               ceres::Problem& problem) {
+  std::vector<PoseParameters>& parameters = blocks.parameters;
+  std::vector<double>& log_scales = blocks.log_scales;
   for (const PoseGraphEdge& edge : graph.edges) {
     if (options.optimize_scale) {
       auto* cost = new ceres::AutoDiffCostFunction<RelativeSimilarityError, 7, 7, 1, 7, 1>(
@@ -154,36 +157,62 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
                                parameters[edge.second].data());
     }
   }
+}
+
+// Sets the pose manifold on every node with edges and holds the fixed nodes; without a fixed
+// node the first node with edges is held (the gauge).
+void hold_gauge(const PoseGraph& graph, const PoseGraphOptions& options, NodeBlocks& blocks,
+                ceres::Manifold* manifold, ceres::Problem& problem) {
   const auto hold = [&](size_t k) {
-    problem.SetParameterBlockConstant(parameters[k].data());
-    if (options.optimize_scale) problem.SetParameterBlockConstant(&log_scales[k]);
+    problem.SetParameterBlockConstant(blocks.parameters[k].data());
+    if (options.optimize_scale) problem.SetParameterBlockConstant(&blocks.log_scales[k]);
   };
   bool any_fixed = false;
   for (size_t k = 0; k < graph.nodes.size(); ++k) {
-    double* block = parameters[k].data();
+    double* block = blocks.parameters[k].data();
     if (!problem.HasParameterBlock(block)) continue;  // a node without edges stays as it is
-    problem.SetManifold(block, &manifold);
+    problem.SetManifold(block, manifold);
     if (graph.nodes[k].fixed) {
       hold(k);
       any_fixed = true;
     }
   }
-  if (!any_fixed) {
-    for (size_t k = 0; k < graph.nodes.size(); ++k) {
-      if (!problem.HasParameterBlock(parameters[k].data())) continue;
-      hold(k);
-      break;
-    }
+  if (any_fixed) return;
+  for (size_t k = 0; k < graph.nodes.size(); ++k) {
+    if (!problem.HasParameterBlock(blocks.parameters[k].data())) continue;
+    hold(k);
+    break;
   }
+}
 
+ceres::Solver::Options pose_graph_solver_options(const PoseGraphOptions& options) {
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.max_solver_time_in_seconds = options.max_seconds;
   solver_options.num_threads = options.num_threads;
   solver_options.logging_type = ceres::SILENT;
+  return solver_options;
+}
+
+}  // namespace
+
+PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& options) {
+  PoseGraphResult result;
+  check_edges(graph);
+  if (graph.nodes.empty() || graph.edges.empty()) return result;
+  NodeBlocks blocks = node_blocks(graph);
+
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>> manifold{
+      ceres::EigenQuaternionManifold(), ceres::EuclideanManifold<3>()};
+  add_edges(graph, options, blocks, problem);
+  hold_gauge(graph, options, blocks, &manifold, problem);
+
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  ceres::Solve(pose_graph_solver_options(options), &problem, &summary);
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
@@ -191,10 +220,11 @@ PoseGraphResult optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& op
   if (!result.usable) return result;
   for (size_t k = 0; k < graph.nodes.size(); ++k) {
     if (graph.nodes[k].fixed) continue;
-    const Pose rigid = parameters[k].to_pose();
-    graph.nodes[k].S_camera_world = Sim3(
-        rigid.linear(), rigid.translation(),
-        options.optimize_scale ? std::exp(log_scales[k]) : graph.nodes[k].S_camera_world.scale);
+    const Pose rigid = blocks.parameters[k].to_pose();
+    graph.nodes[k].S_camera_world =
+        Sim3(rigid.linear(), rigid.translation(),
+             options.optimize_scale ? std::exp(blocks.log_scales[k])
+                                    : graph.nodes[k].S_camera_world.scale);
   }
   return result;
 }

@@ -242,12 +242,9 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
     pose = apply_update(delta, pose);
 
     // Re-classify all observations, including earlier outliers: a better pose can redeem them.
-    int num_inliers = 0;
-    for (size_t i = 0; i < observations.size(); ++i) {
-      const double threshold = has_depth(observations[i]) ? options.chi2_stereo : options.chi2_mono;
-      inlier[i] = observation_chi_squared(model, observations[i], pose) <= threshold;
-      num_inliers += inlier[i];
-    }
+    const int num_inliers = classify_by_chi2(
+        observations, options.chi2_mono, options.chi2_stereo,
+        [&](size_t i) { return observation_chi_squared(model, observations[i], pose); }, inlier);
     if (num_inliers < options.min_inliers_to_continue) break;
   }
 

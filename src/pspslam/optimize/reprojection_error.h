@@ -8,7 +8,9 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/optimize/depth_noise_model.h"
@@ -100,6 +102,23 @@ inline double chi_squared(const StereoProjection& model, const Measurement<kResi
     return std::numeric_limits<double>::infinity();
   }
   return residual.squaredNorm();
+}
+
+// The outlier classification after a solve (ORB-SLAM2's χ² test): observation i is an inlier
+// when chi2_of(i) is at most chi2_stereo for an observation with a right coordinate (right_u not
+// NaN: 3 residuals), chi2_mono otherwise (2). Every observation is classified, earlier outliers
+// too. Returns the number of inliers.
+template <typename Observation, typename Chi2Of>
+inline int classify_by_chi2(const std::vector<Observation>& observations, double chi2_mono,
+                            double chi2_stereo, const Chi2Of& chi2_of,
+                            std::vector<std::uint8_t>& inlier) {
+  int inliers = 0;
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const double threshold = std::isnan(observations[i].right_u) ? chi2_mono : chi2_stereo;
+    inlier[i] = chi2_of(i) <= threshold;
+    inliers += inlier[i];
+  }
+  return inliers;
 }
 
 // Writes ∂r/∂δ = ∂r/∂p_c · [−[p_c]×, I] (the PoseManifold tangent) into the first six columns of a

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -156,17 +157,7 @@ struct KeyFrameRecord {
   std::vector<std::uint64_t> point_ids;  // per keypoint
 };
 
-}  // namespace
-
-MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid& pyramid,
-                        const std::filesystem::path& file) {
-  std::lock_guard lock(map.update_mutex());
-  const auto keyframes = map.keyframes();
-  const auto points = map.map_points();
-  std::unordered_map<std::uint64_t, bool> saved_point;
-  saved_point.reserve(points.size());
-
-  Writer out;
+void put_camera(Writer& out, const CameraModel& camera, const ScalePyramid& pyramid) {
   out.put(camera.pinhole.fx);
   out.put(camera.pinhole.fy);
   out.put(camera.pinhole.cx);
@@ -176,56 +167,51 @@ MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid&
   out.put(static_cast<std::uint32_t>(camera.pinhole.height));
   out.put(static_cast<std::uint32_t>(pyramid.levels));
   out.put(pyramid.scale_factor);
+}
 
-  std::vector<std::shared_ptr<KeyFrame>> good_keyframes;
-  for (const auto& keyframe : keyframes) {
-    if (!keyframe->is_bad()) good_keyframes.push_back(keyframe);
-  }
-  std::vector<std::shared_ptr<MapPoint>> good_points;
-  for (const auto& point : points) {
-    if (point->is_bad()) continue;
-    good_points.push_back(point);
-    saved_point[point->id()] = true;
-  }
-  out.put(static_cast<std::uint64_t>(good_keyframes.size()));
-  out.put(static_cast<std::uint64_t>(good_points.size()));
-  for (const auto& point : good_points) {
-    out.put(point->id());
-    const Eigen::Vector3d position = point->position();
-    for (int r = 0; r < 3; ++r) out.put(position(r));
-    const auto reference = point->reference_keyframe();
-    out.put(reference && !reference->is_bad() ? reference->id() : kNone);
-    out.put(point->first_keyframe_id);
-  }
-  MapFileSummary summary;
-  for (const auto& keyframe : good_keyframes) {
-    out.put(keyframe->id());
-    out.put(keyframe->frame_id());
-    out.put(keyframe->timestamp());
-    put_pose(out, keyframe->T_camera_world());
-    const auto parent = keyframe->parent();
-    out.put(parent && !parent->is_bad() ? parent->id() : kNone);
-    const int n = keyframe->size();
-    out.put(static_cast<std::uint32_t>(n));
-    const auto associations = keyframe->map_points();
-    for (int i = 0; i < n; ++i) {
-      const cv::KeyPoint& kp = keyframe->keypoints()[i];
-      out.put(kp.pt.x);
-      out.put(kp.pt.y);
-      out.put(kp.size);
-      out.put(kp.angle);
-      out.put(kp.response);
-      out.put(static_cast<std::int32_t>(kp.octave));
-      out.put(keyframe->depth(i));
-      const auto& point = associations[i];
-      const bool saved = point && saved_point.contains(point->id());
-      out.put(saved ? point->id() : kNone);
-      summary.observations += saved ? 1 : 0;
-    }
-    for (int i = 0; i < n; ++i) out.put_bytes(keyframe->descriptor(i), kDescriptorBytes);
-  }
+void put_point(Writer& out, const MapPoint& point) {
+  out.put(point.id());
+  const Eigen::Vector3d position = point.position();
+  for (int r = 0; r < 3; ++r) out.put(position(r));
+  const auto reference = point.reference_keyframe();
+  out.put(reference && !reference->is_bad() ? reference->id() : kNone);
+  out.put(point.first_keyframe_id);
+}
 
-  const std::vector<char>& payload = out.buffer();
+// A keyframe with its keypoints, their associations to the saved points and the descriptors.
+// Returns the number of observations written.
+std::size_t put_keyframe(Writer& out, const KeyFrame& keyframe,
+                         const std::unordered_map<std::uint64_t, bool>& saved_point) {
+  out.put(keyframe.id());
+  out.put(keyframe.frame_id());
+  out.put(keyframe.timestamp());
+  put_pose(out, keyframe.T_camera_world());
+  const auto parent = keyframe.parent();
+  out.put(parent && !parent->is_bad() ? parent->id() : kNone);
+  const int n = keyframe.size();
+  out.put(static_cast<std::uint32_t>(n));
+  const auto associations = keyframe.map_points();
+  std::size_t observations = 0;
+  for (int i = 0; i < n; ++i) {
+    const cv::KeyPoint& kp = keyframe.keypoints()[i];
+    out.put(kp.pt.x);
+    out.put(kp.pt.y);
+    out.put(kp.size);
+    out.put(kp.angle);
+    out.put(kp.response);
+    out.put(static_cast<std::int32_t>(kp.octave));
+    out.put(keyframe.depth(i));
+    const auto& point = associations[i];
+    const bool saved = point && saved_point.contains(point->id());
+    out.put(saved ? point->id() : kNone);
+    observations += saved ? 1 : 0;
+  }
+  for (int i = 0; i < n; ++i) out.put_bytes(keyframe.descriptor(i), kDescriptorBytes);
+  return observations;
+}
+
+// The header (magic, version, size and checksum of the payload), then the payload.
+void write_map_file(const std::filesystem::path& file, const std::vector<char>& payload) {
   Writer header;
   header.put_bytes(kMagic.data(), kMagic.size());
   header.put(kFormatVersion);
@@ -239,20 +225,16 @@ MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid&
   stream.write(payload.data(), static_cast<std::streamsize>(payload.size()));
   stream.close();
   if (!stream) throw Error("map file '" + file.string() + "': write failed (disk full?)");
-  summary.keyframes = good_keyframes.size();
-  summary.map_points = good_points.size();
-  summary.bytes = kHeaderBytes + payload.size();
-  return summary;
 }
 
-MapFileSummary load_map(const std::filesystem::path& file, Map& map,
-                        std::shared_ptr<const CameraModel> camera,
-                        std::shared_ptr<const ScalePyramid> pyramid) {
-  const std::string prefix = "map file '" + file.string() + "': ";
+std::string read_whole_file(const std::filesystem::path& file, const std::string& prefix) {
   std::ifstream stream(file, std::ios::binary);
   if (!stream) throw Error(prefix + "cannot open for reading");
-  const std::string bytes((std::istreambuf_iterator<char>(stream)),
-                          std::istreambuf_iterator<char>());
+  return std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+}
+
+// The payload of a file whose header (magic, version, size, checksum) holds.
+std::string_view checked_payload(const std::string& bytes, const std::string& prefix) {
   if (bytes.size() >= kMagic.size() && !std::equal(kMagic.begin(), kMagic.end(), bytes.begin()))
     throw Error(prefix + "not a pspslam map (bad magic, expected \"PSPSLMAP\")");
   if (bytes.size() < kHeaderBytes) {
@@ -284,128 +266,173 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
     throw Error(prefix + "checksum mismatch (stored " + hex64(stored_checksum) + ", computed " +
                 hex64(checksum) + "): the file is corrupt");
   }
+  return {payload, payload_bytes};
+}
 
-  Reader in(payload, payload_bytes, prefix);
-  check_same(prefix, "fx", in.get<double>("camera"), camera->pinhole.fx);
-  check_same(prefix, "fy", in.get<double>("camera"), camera->pinhole.fy);
-  check_same(prefix, "cx", in.get<double>("camera"), camera->pinhole.cx);
-  check_same(prefix, "cy", in.get<double>("camera"), camera->pinhole.cy);
-  check_same(prefix, "bf (fx * virtual baseline)", in.get<double>("camera"), camera->bf);
-  check_same(prefix, "image width", in.get<std::uint32_t>("camera"), camera->pinhole.width);
-  check_same(prefix, "image height", in.get<std::uint32_t>("camera"), camera->pinhole.height);
-  check_same(prefix, "ORB pyramid levels", in.get<std::uint32_t>("pyramid"), pyramid->levels);
-  check_same(prefix, "ORB scale factor", in.get<double>("pyramid"), pyramid->scale_factor);
+void check_camera(Reader& in, const std::string& prefix, const CameraModel& camera,
+                  const ScalePyramid& pyramid) {
+  check_same(prefix, "fx", in.get<double>("camera"), camera.pinhole.fx);
+  check_same(prefix, "fy", in.get<double>("camera"), camera.pinhole.fy);
+  check_same(prefix, "cx", in.get<double>("camera"), camera.pinhole.cx);
+  check_same(prefix, "cy", in.get<double>("camera"), camera.pinhole.cy);
+  check_same(prefix, "bf (fx * virtual baseline)", in.get<double>("camera"), camera.bf);
+  check_same(prefix, "image width", in.get<std::uint32_t>("camera"), camera.pinhole.width);
+  check_same(prefix, "image height", in.get<std::uint32_t>("camera"), camera.pinhole.height);
+  check_same(prefix, "ORB pyramid levels", in.get<std::uint32_t>("pyramid"), pyramid.levels);
+  check_same(prefix, "ORB scale factor", in.get<double>("pyramid"), pyramid.scale_factor);
+}
 
-  const auto keyframe_count = in.get<std::uint64_t>("keyframe count");
-  const auto point_count = in.get<std::uint64_t>("map point count");
+// What the payload holds, checked, with the index of every id.
+struct MapRecords {
+  std::vector<PointRecord> points;
+  std::unordered_map<std::uint64_t, std::size_t> point_index;
+  std::vector<KeyFrameRecord> keyframes;
+  std::unordered_map<std::uint64_t, std::size_t> keyframe_index;
+};
+
+void read_points(Reader& in, std::uint64_t point_count, MapRecords& records) {
   // Counts are checked against what the rest of the payload could hold before reserving.
   if (point_count > in.remaining() / 48) in.fail("map point count " + std::to_string(point_count));
-  std::vector<PointRecord> point_records(point_count);
-  std::unordered_map<std::uint64_t, std::size_t> point_index;
-  for (PointRecord& record : point_records) {
+  records.points.resize(point_count);
+  for (PointRecord& record : records.points) {
     record.id = in.get<std::uint64_t>("map point id");
     for (int r = 0; r < 3; ++r) record.position(r) = in.get<double>("map point position");
     record.reference_keyframe = in.get<std::uint64_t>("map point reference keyframe");
     record.first_keyframe = in.get<std::uint64_t>("map point first keyframe");
     if (!record.position.allFinite())
       in.fail("map point " + std::to_string(record.id) + " position is not finite");
-    if (!point_index.emplace(record.id, point_index.size()).second)
+    if (!records.point_index.emplace(record.id, records.point_index.size()).second)
       in.fail("map point id " + std::to_string(record.id) + " appears twice");
   }
+}
+
+// A keyframe's keypoints, map point ids and descriptors.
+void read_keypoints(Reader& in, int pyramid_levels,
+                    const std::unordered_map<std::uint64_t, std::size_t>& point_index,
+                    KeyFrameRecord& record) {
+  const auto n = in.get<std::uint32_t>("keypoint count");
+  if (n > in.remaining() / (kKeypointBytes + kDescriptorBytes))
+    in.fail("keyframe " + std::to_string(record.id) + " keypoint count " + std::to_string(n));
+  record.data.keypoints.resize(n);
+  record.data.depth.resize(n);
+  record.point_ids.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    cv::KeyPoint& kp = record.data.keypoints[i];
+    kp.pt.x = in.get<float>("keypoint");
+    kp.pt.y = in.get<float>("keypoint");
+    kp.size = in.get<float>("keypoint");
+    kp.angle = in.get<float>("keypoint");
+    kp.response = in.get<float>("keypoint");
+    kp.octave = in.get<std::int32_t>("keypoint");
+    record.data.depth[i] = in.get<float>("keypoint depth");
+    record.point_ids[i] = in.get<std::uint64_t>("keypoint map point");
+    if (kp.octave < 0 || kp.octave >= pyramid_levels || !std::isfinite(kp.pt.x) ||
+        !std::isfinite(kp.pt.y) || !std::isfinite(record.data.depth[i]))
+      in.fail("keyframe " + std::to_string(record.id) + " keypoint " + std::to_string(i));
+    if (record.point_ids[i] != kNone && !point_index.contains(record.point_ids[i]))
+      in.fail("keyframe " + std::to_string(record.id) + " refers to unknown map point " +
+              std::to_string(record.point_ids[i]));
+  }
+  const char* descriptors = in.take(std::size_t{n} * kDescriptorBytes, "descriptors");
+  record.data.descriptors.create(static_cast<int>(n), static_cast<int>(kDescriptorBytes), CV_8UC1);
+  if (n > 0)
+    std::memcpy(record.data.descriptors.data, descriptors, std::size_t{n} * kDescriptorBytes);
+}
+
+void read_keyframes(Reader& in, std::uint64_t keyframe_count, int pyramid_levels,
+                    MapRecords& records) {
   if (keyframe_count == 0) in.fail("no keyframes");
   if (keyframe_count > in.remaining() / 140)
     in.fail("keyframe count " + std::to_string(keyframe_count));
-  std::vector<KeyFrameRecord> keyframe_records(keyframe_count);
-  std::unordered_map<std::uint64_t, std::size_t> keyframe_index;
-  for (KeyFrameRecord& record : keyframe_records) {
+  records.keyframes.resize(keyframe_count);
+  for (KeyFrameRecord& record : records.keyframes) {
     record.id = in.get<std::uint64_t>("keyframe id");
-    if (!keyframe_index.emplace(record.id, keyframe_index.size()).second)
+    if (!records.keyframe_index.emplace(record.id, records.keyframe_index.size()).second)
       in.fail("keyframe id " + std::to_string(record.id) + " appears twice");
-    if (keyframe_index.size() > 1 && record.id <= (&record - 1)->id)
+    if (records.keyframe_index.size() > 1 && record.id <= (&record - 1)->id)
       in.fail("keyframe ids are not ascending");
     record.data.frame_id = in.get<std::uint64_t>("keyframe frame id");
     record.data.timestamp = in.get<double>("keyframe timestamp");
     record.data.T_camera_world = get_pose(in);
     record.parent = in.get<std::uint64_t>("keyframe parent");
-    const auto n = in.get<std::uint32_t>("keypoint count");
-    if (n > in.remaining() / (kKeypointBytes + kDescriptorBytes))
-      in.fail("keyframe " + std::to_string(record.id) + " keypoint count " + std::to_string(n));
-    record.data.keypoints.resize(n);
-    record.data.depth.resize(n);
-    record.point_ids.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      cv::KeyPoint& kp = record.data.keypoints[i];
-      kp.pt.x = in.get<float>("keypoint");
-      kp.pt.y = in.get<float>("keypoint");
-      kp.size = in.get<float>("keypoint");
-      kp.angle = in.get<float>("keypoint");
-      kp.response = in.get<float>("keypoint");
-      kp.octave = in.get<std::int32_t>("keypoint");
-      record.data.depth[i] = in.get<float>("keypoint depth");
-      record.point_ids[i] = in.get<std::uint64_t>("keypoint map point");
-      if (kp.octave < 0 || kp.octave >= pyramid->levels || !std::isfinite(kp.pt.x) ||
-          !std::isfinite(kp.pt.y) || !std::isfinite(record.data.depth[i]))
-        in.fail("keyframe " + std::to_string(record.id) + " keypoint " + std::to_string(i));
-      if (record.point_ids[i] != kNone && !point_index.contains(record.point_ids[i]))
-        in.fail("keyframe " + std::to_string(record.id) + " refers to unknown map point " +
-                std::to_string(record.point_ids[i]));
-    }
-    const char* descriptors = in.take(std::size_t{n} * kDescriptorBytes, "descriptors");
-    record.data.descriptors.create(static_cast<int>(n), static_cast<int>(kDescriptorBytes),
-                                   CV_8UC1);
-    if (n > 0)
-      std::memcpy(record.data.descriptors.data, descriptors, std::size_t{n} * kDescriptorBytes);
+    read_keypoints(in, pyramid_levels, records.point_index, record);
   }
+}
+
+// The payload after the camera check: points, keyframes, and nothing left over.
+MapRecords read_records(Reader& in, const std::string& prefix, int pyramid_levels) {
+  MapRecords records;
+  const auto keyframe_count = in.get<std::uint64_t>("keyframe count");
+  const auto point_count = in.get<std::uint64_t>("map point count");
+  read_points(in, point_count, records);
+  read_keyframes(in, keyframe_count, pyramid_levels, records);
   if (in.remaining() != 0)
     in.fail(std::to_string(in.remaining()) + " bytes left after the last keyframe");
-  for (const KeyFrameRecord& record : keyframe_records) {
-    if (record.parent != kNone && !keyframe_index.contains(record.parent))
+  for (const KeyFrameRecord& record : records.keyframes) {
+    if (record.parent != kNone && !records.keyframe_index.contains(record.parent))
       throw Error(prefix + "inconsistent content: keyframe " + std::to_string(record.id) +
                   " has unknown parent " + std::to_string(record.parent));
   }
+  return records;
+}
 
-  // The file is consistent: build the map.
-  if (map.num_keyframes() != 0 || map.num_map_points() != 0)
-    throw Error(prefix + "cannot load into a map that already has keyframes or points");
-  // Keyframes and points keep the ids they were saved with (the file is in ascending id order),
-  // so a map loaded and saved again without change is the same file byte for byte (localisation
-  // promises not to change the map); new ids continue after the largest loaded ones.
-  std::lock_guard lock(map.update_mutex());
-  std::uint64_t max_point_id = 0;
-  for (const PointRecord& record : point_records) max_point_id = std::max(max_point_id, record.id);
-  map.continue_ids_after(keyframe_records.empty() ? 0 : keyframe_records.back().id, max_point_id);
-  std::vector<std::shared_ptr<KeyFrame>> keyframes;
-  keyframes.reserve(keyframe_records.size());
-  for (KeyFrameRecord& record : keyframe_records) {
-    keyframes.push_back(
-        std::make_shared<KeyFrame>(record.id, std::move(record.data), camera, pyramid));
-    map.add_keyframe(keyframes.back());
-  }
+std::vector<std::shared_ptr<MapPoint>> make_points(
+    const MapRecords& records, const std::vector<std::shared_ptr<KeyFrame>>& keyframes) {
   std::vector<std::shared_ptr<MapPoint>> points;
-  points.reserve(point_records.size());
-  for (const PointRecord& record : point_records) {
-    const auto reference = keyframe_index.find(record.reference_keyframe);
+  points.reserve(records.points.size());
+  for (const PointRecord& record : records.points) {
+    const auto reference = records.keyframe_index.find(record.reference_keyframe);
     const std::shared_ptr<KeyFrame>& reference_keyframe =
-        keyframes[reference != keyframe_index.end() ? reference->second : 0];
+        keyframes[reference != records.keyframe_index.end() ? reference->second : 0];
     auto point = std::make_shared<MapPoint>(record.id, record.position, reference_keyframe);
     // Kept as saved even when that keyframe was culled before saving: only its order against
     // newer keyframes matters (recent-point culling), and the file must save back unchanged.
     point->first_keyframe_id = record.first_keyframe;
     points.push_back(point);
   }
-  MapFileSummary summary;
+  return points;
+}
+
+// Links keyframes and points both ways; returns the number of observations.
+std::size_t add_observations(const MapRecords& records,
+                             const std::vector<std::shared_ptr<KeyFrame>>& keyframes,
+                             const std::vector<std::shared_ptr<MapPoint>>& points) {
+  std::size_t observations = 0;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const auto& ids = keyframe_records[k].point_ids;
+    const auto& ids = records.keyframes[k].point_ids;
     for (int i = 0; i < static_cast<int>(ids.size()); ++i) {
       if (ids[i] == kNone) continue;
-      const auto& point = points[point_index.at(ids[i])];
+      const auto& point = points[records.point_index.at(ids[i])];
       // A point has one observation per keyframe (the live system enforces it too).
       if (point->is_observed_by(keyframes[k]->id())) continue;
       keyframes[k]->add_map_point(i, point);
       point->add_observation(keyframes[k], i);
-      ++summary.observations;
+      ++observations;
     }
   }
+  return observations;
+}
+
+// Builds the map of consistent records; the summary has no byte count yet.
+MapFileSummary build_map(MapRecords& records, Map& map, std::shared_ptr<const CameraModel> camera,
+                         std::shared_ptr<const ScalePyramid> pyramid) {
+  // Keyframes and points keep the ids they were saved with (the file is in ascending id order),
+  // so a map loaded and saved again without change is the same file byte for byte (localisation
+  // promises not to change the map); new ids continue after the largest loaded ones.
+  std::lock_guard lock(map.update_mutex());
+  std::uint64_t max_point_id = 0;
+  for (const PointRecord& record : records.points) max_point_id = std::max(max_point_id, record.id);
+  map.continue_ids_after(records.keyframes.empty() ? 0 : records.keyframes.back().id, max_point_id);
+  std::vector<std::shared_ptr<KeyFrame>> keyframes;
+  keyframes.reserve(records.keyframes.size());
+  for (KeyFrameRecord& record : records.keyframes) {
+    keyframes.push_back(
+        std::make_shared<KeyFrame>(record.id, std::move(record.data), camera, pyramid));
+    map.add_keyframe(keyframes.back());
+  }
+  const std::vector<std::shared_ptr<MapPoint>> points = make_points(records, keyframes);
+  MapFileSummary summary;
+  summary.observations = add_observations(records, keyframes, points);
   for (const auto& point : points) {
     if (point->num_observations() == 0) continue;  // observed by no saved keyframe
     point->compute_distinctive_descriptor();
@@ -416,12 +443,66 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
   // Spanning tree as saved (parents before update_connections, which would otherwise pick
   // the best covisible keyframe, possibly a later one), then covisibility.
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const std::uint64_t parent = keyframe_records[k].parent;
-    if (parent != kNone && parent != keyframe_records[k].id)
-      keyframes[k]->change_parent(keyframes[keyframe_index.at(parent)]);
+    const std::uint64_t parent = records.keyframes[k].parent;
+    if (parent != kNone && parent != records.keyframes[k].id)
+      keyframes[k]->change_parent(keyframes[records.keyframe_index.at(parent)]);
   }
   for (const auto& keyframe : keyframes) keyframe->update_connections();
   summary.keyframes = keyframes.size();
+  return summary;
+}
+
+}  // namespace
+
+MapFileSummary save_map(Map& map, const CameraModel& camera, const ScalePyramid& pyramid,
+                        const std::filesystem::path& file) {
+  std::lock_guard lock(map.update_mutex());
+  const auto keyframes = map.keyframes();
+  const auto points = map.map_points();
+  std::unordered_map<std::uint64_t, bool> saved_point;
+  saved_point.reserve(points.size());
+
+  Writer out;
+  put_camera(out, camera, pyramid);
+  std::vector<std::shared_ptr<KeyFrame>> good_keyframes;
+  for (const auto& keyframe : keyframes) {
+    if (!keyframe->is_bad()) good_keyframes.push_back(keyframe);
+  }
+  std::vector<std::shared_ptr<MapPoint>> good_points;
+  for (const auto& point : points) {
+    if (point->is_bad()) continue;
+    good_points.push_back(point);
+    saved_point[point->id()] = true;
+  }
+  out.put(static_cast<std::uint64_t>(good_keyframes.size()));
+  out.put(static_cast<std::uint64_t>(good_points.size()));
+  for (const auto& point : good_points) put_point(out, *point);
+  MapFileSummary summary;
+  for (const auto& keyframe : good_keyframes)
+    summary.observations += put_keyframe(out, *keyframe, saved_point);
+
+  const std::vector<char>& payload = out.buffer();
+  write_map_file(file, payload);
+  summary.keyframes = good_keyframes.size();
+  summary.map_points = good_points.size();
+  summary.bytes = kHeaderBytes + payload.size();
+  return summary;
+}
+
+MapFileSummary load_map(const std::filesystem::path& file, Map& map,
+                        std::shared_ptr<const CameraModel> camera,
+                        std::shared_ptr<const ScalePyramid> pyramid) {
+  const std::string prefix = "map file '" + file.string() + "': ";
+  const std::string bytes = read_whole_file(file, prefix);
+  const std::string_view payload = checked_payload(bytes, prefix);
+  Reader in(payload.data(), payload.size(), prefix);
+  check_camera(in, prefix, *camera, *pyramid);
+  MapRecords records = read_records(in, prefix, pyramid->levels);
+
+  // The file is consistent: build the map.
+  if (map.num_keyframes() != 0 || map.num_map_points() != 0)
+    throw Error(prefix + "cannot load into a map that already has keyframes or points");
+  MapFileSummary summary = build_map(records, map, std::move(camera), std::move(pyramid));
   summary.bytes = bytes.size();
   return summary;
 }

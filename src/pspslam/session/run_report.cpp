@@ -175,17 +175,14 @@ LostStretchEnding ending(RunStatistics::LostStretch::End end) {
   return {"?", "?"};
 }
 
-}  // namespace
-
-void write_run_report(const RunReportInput& input, std::ostream& out) {
+// Frames, speed, map size and what local mapping did (and the loops, when they are closed).
+void print_frames_and_map(const RunReportInput& input, std::ostream& out) {
   const RunStatistics& stats = input.statistics;
   const MappingStats& mapping = input.mapping;
   const SystemOptions& system = input.options.system;
-  const std::filesystem::path& out_dir = input.options.outputs.folder;
   const size_t processed = stats.processed();
   const size_t lost_count = stats.lost();
   const double seconds = input.seconds;
-
   char line[512];
   std::snprintf(line, sizeof(line),
                 "frames:       %zu processed, %zu tracked, %zu without pose (lost_frames.txt)\n"
@@ -210,104 +207,135 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                 mapping.points_fused, mapping.points_culled, mapping.ba_outliers_removed,
                 mapping.local_ba_cut_short, window.c_str());
   out << line;
-  const bool monocular = input.sensor == SensorType::monocular;
-  if (system.place.loop_closing) print_loop_stats(mapping, monocular, out);
-  // A loaded map (--load-map) is there from the first frame: no two-view start to report.
-  const bool map_loaded = !system.map_file.empty();
-  if (monocular) {
-    if (map_loaded) {
-      const size_t tracked = stats.processed() - stats.lost();
-      std::snprintf(line, sizeof(line),
-                    "monocular:    map loaded (no two-view start); %zu of %zu frames tracked "
-                    "(%.1f %%)\n",
-                    tracked, stats.processed(),
-                    stats.processed() > 0 ? 100.0 * tracked / stats.processed() : 0.0);
-    } else if (stats.initialised_at()) {
-      const size_t since = stats.processed_since_initialisation();
-      std::snprintf(line, sizeof(line),
-                    "monocular:    map started at frame %zu (%zu frames before it placed in the "
-                    "first map); %zu of %zu frames tracked from there (%.1f %%), %zu map "
-                    "restarts\n",
-                    *stats.initialised_at(), stats.placed_before_initialisation(),
-                    stats.tracked_since_initialisation(), since,
-                    since > 0 ? 100.0 * stats.tracked_since_initialisation() / since : 0.0,
-                    stats.map_restarts());
-    } else {
-      std::snprintf(line, sizeof(line),
-                    "monocular:    the map never started (no two frames with enough parallax "
-                    "and matches)\n");
-    }
-    out << line;
-  }
-  if (const auto longest = stats.longest_lost_stretch()) {
-    const size_t stretches = stats.lost_stretches();
-    std::snprintf(line, sizeof(line),
-                  "lost:         %zu stretch%s after the map started; the longest: frames "
-                  "%zu-%zu (%zu frames), %s\n",
-                  stretches, stretches == 1 ? "" : "es", longest->first_frame, longest->last_frame,
-                  longest->frames, ending(longest->end).words);
-    out << line;
-  }
-  out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
-      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv,\n"
-      << "              run_config.yaml (the config used)\n";
-  std::optional<AteResult> ate_tracked;
-  std::optional<AteResult> ate_refined;
-  const std::optional<Trajectory>& ground_truth = input.source.ground_truth();
-  if (ground_truth && input.estimate.size() >= 3) {
-    const std::tuple<const char*, const Trajectory*, std::optional<AteResult>*> evaluated[] = {
-        {"trajectory.txt        ", &input.estimate, &ate_tracked},
-        {"trajectory_refined.txt", &input.refined, &ate_refined}};
-    for (const auto& [name, poses, slot] : evaluated) {
-      try {
-        // A monocular map has its own scale: only a similarity aligns it.
-        const AteResult ate = compute_ate(*ground_truth, *poses, AteOptions{.sim3 = monocular});
-        std::snprintf(line, sizeof(line),
-                      "ATE %s (%s aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
-                      "%.4f m, max %.4f m%s\n",
-                      name, monocular ? "Sim(3)" : "SE(3)", ate.error.count, ate.error.rmse,
-                      ate.error.mean, ate.error.median, ate.error.max,
-                      monocular ? (", scale " + std::to_string(ate.alignment.scale)).c_str() : "");
-        out << line;
-        *slot = ate;
-      } catch (const Error& e) {
-        out << "ATE " << name << ": not computed: " << e.what() << "\n";
-      }
-    }
-  }
-  nlohmann::ordered_json blackout_json;  // a stats.json member, null without a blackout
-  if (input.options.blackout)
-    blackout_json = report_blackout(input, *input.options.blackout, ate_tracked, out);
+  if (system.place.loop_closing)
+    print_loop_stats(mapping, input.sensor == SensorType::monocular, out);
+}
 
-  // Per-module timing and the dynamic-feature totals, printed and written to stats.json.
-  const TimingSummary t_extraction = summarize(stats.extraction_ms);
-  const TimingSummary t_semantic = summarize(stats.semantic_ms);
-  const TimingSummary t_semantic_wait = summarize(stats.semantic_wait_ms);
-  const TimingSummary t_geometry = summarize(stats.geometry_ms);
-  const TimingSummary t_search = summarize(stats.geometry_search_ms);
-  const TimingSummary t_flow = summarize(stats.flow_ms);
-  const TimingSummary t_tracking = summarize(stats.tracking_ms);
-  const TimingSummary t_mapping = summarize(stats.local_mapping_ms);
-  const TimingSummary mask_age = summarize(stats.mask_age_frames);
-  const TimingSummary mask_latency = summarize(stats.mask_latency_ms);
+// How a monocular map started: loaded, after a two-view start, or never.
+void print_monocular_start(const RunStatistics& stats, bool map_loaded, std::ostream& out) {
+  char line[512];
+  if (map_loaded) {
+    const size_t tracked = stats.processed() - stats.lost();
+    std::snprintf(line, sizeof(line),
+                  "monocular:    map loaded (no two-view start); %zu of %zu frames tracked "
+                  "(%.1f %%)\n",
+                  tracked, stats.processed(),
+                  stats.processed() > 0 ? 100.0 * tracked / stats.processed() : 0.0);
+  } else if (stats.initialised_at()) {
+    const size_t since = stats.processed_since_initialisation();
+    std::snprintf(line, sizeof(line),
+                  "monocular:    map started at frame %zu (%zu frames before it placed in the "
+                  "first map); %zu of %zu frames tracked from there (%.1f %%), %zu map "
+                  "restarts\n",
+                  *stats.initialised_at(), stats.placed_before_initialisation(),
+                  stats.tracked_since_initialisation(), since,
+                  since > 0 ? 100.0 * stats.tracked_since_initialisation() / since : 0.0,
+                  stats.map_restarts());
+  } else {
+    std::snprintf(line, sizeof(line),
+                  "monocular:    the map never started (no two frames with enough parallax "
+                  "and matches)\n");
+  }
+  out << line;
+}
+
+void print_longest_lost_stretch(const RunStatistics& stats, std::ostream& out) {
+  const auto longest = stats.longest_lost_stretch();
+  if (!longest) return;
+  const size_t stretches = stats.lost_stretches();
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "lost:         %zu stretch%s after the map started; the longest: frames "
+                "%zu-%zu (%zu frames), %s\n",
+                stretches, stretches == 1 ? "" : "es", longest->first_frame, longest->last_frame,
+                longest->frames, ending(longest->end).words);
+  out << line;
+}
+
+// The ATE of both trajectories against the sequence's ground truth, when it has one.
+struct RunAte {
+  std::optional<AteResult> tracked;
+  std::optional<AteResult> refined;
+};
+
+RunAte report_ate(const RunReportInput& input, bool monocular, std::ostream& out) {
+  RunAte result;
+  const std::optional<Trajectory>& ground_truth = input.source.ground_truth();
+  if (!ground_truth || input.estimate.size() < 3) return result;
+  const std::tuple<const char*, const Trajectory*, std::optional<AteResult>*> evaluated[] = {
+      {"trajectory.txt        ", &input.estimate, &result.tracked},
+      {"trajectory_refined.txt", &input.refined, &result.refined}};
+  char line[512];
+  for (const auto& [name, poses, slot] : evaluated) {
+    try {
+      // A monocular map has its own scale: only a similarity aligns it.
+      const AteResult ate = compute_ate(*ground_truth, *poses, AteOptions{.sim3 = monocular});
+      std::snprintf(line, sizeof(line),
+                    "ATE %s (%s aligned, %zu poses): RMSE %.4f m, mean %.4f m, median "
+                    "%.4f m, max %.4f m%s\n",
+                    name, monocular ? "Sim(3)" : "SE(3)", ate.error.count, ate.error.rmse,
+                    ate.error.mean, ate.error.median, ate.error.max,
+                    monocular ? (", scale " + std::to_string(ate.alignment.scale)).c_str() : "");
+      out << line;
+      *slot = ate;
+    } catch (const Error& e) {
+      out << "ATE " << name << ": not computed: " << e.what() << "\n";
+    }
+  }
+  return result;
+}
+
+// Per-module timing and the mask ages, printed and written to stats.json.
+struct ModuleTimings {
+  TimingSummary extraction;
+  TimingSummary semantic;
+  TimingSummary semantic_wait;
+  TimingSummary geometry;
+  TimingSummary search;
+  TimingSummary flow;
+  TimingSummary tracking;
+  TimingSummary mapping;
+  TimingSummary mask_age;
+  TimingSummary mask_latency;
+};
+
+ModuleTimings summarize_modules(const RunStatistics& stats) {
+  return {.extraction = summarize(stats.extraction_ms),
+          .semantic = summarize(stats.semantic_ms),
+          .semantic_wait = summarize(stats.semantic_wait_ms),
+          .geometry = summarize(stats.geometry_ms),
+          .search = summarize(stats.geometry_search_ms),
+          .flow = summarize(stats.flow_ms),
+          .tracking = summarize(stats.tracking_ms),
+          .mapping = summarize(stats.local_mapping_ms),
+          .mask_age = summarize(stats.mask_age_frames),
+          .mask_latency = summarize(stats.mask_latency_ms)};
+}
+
+// Per-module timing, the dynamic-feature totals and the arrival-to-pose latency.
+void print_timing_and_dynamic(const RunReportInput& input, const ModuleTimings& t,
+                              std::ostream& out) {
+  const RunStatistics& stats = input.statistics;
+  char line[512];
   std::snprintf(line, sizeof(line),
                 "timing ms:    median/mean/p95  extraction %.1f/%.1f/%.1f  semantic inference "
                 "%.1f/%.1f/%.1f (waited %.1f/%.1f/%.1f)\n"
                 "              geometry %.1f/%.1f/%.1f (search %.1f)  flow+H %.1f  tracking "
                 "%.1f/%.1f/%.1f  local BA %.1f/%.1f/%.1f\n",
-                t_extraction.median, t_extraction.mean, t_extraction.p95, t_semantic.median,
-                t_semantic.mean, t_semantic.p95, t_semantic_wait.median, t_semantic_wait.mean,
-                t_semantic_wait.p95, t_geometry.median, t_geometry.mean, t_geometry.p95,
-                t_search.median, t_flow.median, t_tracking.median, t_tracking.mean, t_tracking.p95,
-                t_mapping.median, t_mapping.mean, t_mapping.p95);
+                t.extraction.median, t.extraction.mean, t.extraction.p95, t.semantic.median,
+                t.semantic.mean, t.semantic.p95, t.semantic_wait.median, t.semantic_wait.mean,
+                t.semantic_wait.p95, t.geometry.median, t.geometry.mean, t.geometry.p95,
+                t.search.median, t.flow.median, t.tracking.median, t.tracking.mean, t.tracking.p95,
+                t.mapping.median, t.mapping.mean, t.mapping.p95);
   out << line;
   std::snprintf(line, sizeof(line),
                 "dynamic:      mode %s; %zu keypoints tested, %zu flagged by geometry, %zu "
                 "dropped before tracking, %zu map points culled; mask age median %.0f frames "
                 "(%.0f ms), %zu frames without mask, %zu frames dropped by the real-time feed\n",
-                to_string(system.dynamic.mode), stats.tested_points, stats.dynamic_points,
-                stats.masked_keypoints, stats.culled_points, mask_age.median, mask_latency.median,
-                stats.frames_without_mask, stats.realtime_dropped());
+                to_string(input.options.system.dynamic.mode), stats.tested_points,
+                stats.dynamic_points, stats.masked_keypoints, stats.culled_points,
+                t.mask_age.median, t.mask_latency.median, stats.frames_without_mask,
+                stats.realtime_dropped());
   out << line;
   if (!stats.arrival_to_pose_ms.empty()) {
     const LatencySummary arrival = summarize_latency(stats.arrival_to_pose_ms);
@@ -317,34 +345,46 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                   arrival.median, arrival.p99, arrival.max, arrival.count);
     out << line;
   }
-  const nlohmann::ordered_json live_masks = report_live_masks(input, out);
-  const FrameSourceStats source = input.source.stats();
-  if (source.disconnected) out << "input:        " << source.end_reason << "\n";
+}
 
-  const double fps = seconds > 0 ? static_cast<double>(processed) / seconds : 0.0;
-  nlohmann::ordered_json json = {{"sequence", input.source.name()},
-                                 {"version", version_string()},
-                                 {"config", input.config_file.string()},
-                                 {"sensor", to_string(input.sensor)},
-                                 {"mode", to_string(system.dynamic.mode)},
-                                 {"realtime", system.dynamic.realtime},
-                                 {"interrupted", input.interrupted},
-                                 {"frames", processed},
-                                 {"lost_frames", lost_count},
-                                 {"relocalisations", stats.relocalisations()}};
-  if (!blackout_json.is_null()) json["blackout"] = blackout_json;
-  if (input.requested_mode != system.dynamic.mode)
-    json["mode_requested"] = to_string(input.requested_mode);
-  if (monocular) {
-    json["monocular"] = {{"initialised_at_frame",
-                          stats.initialised_at() ? nlohmann::ordered_json(*stats.initialised_at())
-                                                 : nlohmann::ordered_json(nullptr)},
-                         {"frames_since_initialisation", stats.processed_since_initialisation()},
-                         {"tracked_since_initialisation", stats.tracked_since_initialisation()},
-                         {"placed_before_initialisation", stats.placed_before_initialisation()},
-                         {"map_restarts", stats.map_restarts()},
-                         {"map_loaded", map_loaded}};
-  }
+// What the summary printed before stats.json is written: its members that are not read off
+// the statistics again.
+struct ReportedSections {
+  RunAte ate;
+  ModuleTimings timings;
+  nlohmann::ordered_json blackout;    // null without a blackout
+  nlohmann::ordered_json live_masks;  // null except for a live run with semantics
+  FrameSourceStats source;
+};
+
+// stats.json's head: what ran, on what, and how many frames.
+nlohmann::ordered_json run_json(const RunReportInput& input) {
+  const RunStatistics& stats = input.statistics;
+  const SystemOptions& system = input.options.system;
+  return {{"sequence", input.source.name()},
+          {"version", version_string()},
+          {"config", input.config_file.string()},
+          {"sensor", to_string(input.sensor)},
+          {"mode", to_string(system.dynamic.mode)},
+          {"realtime", system.dynamic.realtime},
+          {"interrupted", input.interrupted},
+          {"frames", stats.processed()},
+          {"lost_frames", stats.lost()},
+          {"relocalisations", stats.relocalisations()}};
+}
+
+nlohmann::ordered_json monocular_json(const RunStatistics& stats, bool map_loaded) {
+  return {{"initialised_at_frame", stats.initialised_at()
+                                       ? nlohmann::ordered_json(*stats.initialised_at())
+                                       : nlohmann::ordered_json(nullptr)},
+          {"frames_since_initialisation", stats.processed_since_initialisation()},
+          {"tracked_since_initialisation", stats.tracked_since_initialisation()},
+          {"placed_before_initialisation", stats.placed_before_initialisation()},
+          {"map_restarts", stats.map_restarts()},
+          {"map_loaded", map_loaded}};
+}
+
+nlohmann::ordered_json lost_stretches_json(const RunStatistics& stats) {
   nlohmann::ordered_json longest_lost = nullptr;
   if (const auto longest = stats.longest_lost_stretch()) {
     longest_lost = {{"first_frame", longest->first_frame},
@@ -352,34 +392,24 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                     {"frames", longest->frames},
                     {"end", ending(longest->end).name}};
   }
-  json["lost_stretches"] = {{"count", stats.lost_stretches()}, {"longest", longest_lost}};
-  json["realtime_dropped_frames"] = stats.realtime_dropped();
-  // How the input ended: a camera that was unplugged or fell silent says so here.
-  json["input"] = {{"dropped_frames", source.dropped},
-                   {"disconnected", source.disconnected},
-                   {"end_reason", source.end_reason}};
-  json["seconds"] = seconds;
-  json["fps"] = fps;
-  json["timing_ms"] = {
-      {"extraction", to_json(t_extraction)},       {"semantic", to_json(t_semantic)},
-      {"semantic_wait", to_json(t_semantic_wait)}, {"geometry", to_json(t_geometry)},
-      {"geometry_search", to_json(t_search)},      {"flow_homography", to_json(t_flow)},
-      {"tracking", to_json(t_tracking)},           {"local_mapping", to_json(t_mapping)}};
+  return {{"count", stats.lost_stretches()}, {"longest", longest_lost}};
+}
+
+nlohmann::ordered_json timing_json(const RunStatistics& stats, const ModuleTimings& t) {
+  nlohmann::ordered_json json = {
+      {"extraction", to_json(t.extraction)},       {"semantic", to_json(t.semantic)},
+      {"semantic_wait", to_json(t.semantic_wait)}, {"geometry", to_json(t.geometry)},
+      {"geometry_search", to_json(t.search)},      {"flow_homography", to_json(t.flow)},
+      {"tracking", to_json(t.tracking)},           {"local_mapping", to_json(t.mapping)}};
   if (!stats.observer_cpu_ms.empty())
-    json["timing_ms"]["viewer_hooks_cpu"] = to_json(summarize(stats.observer_cpu_ms));
-  json["dynamic"] = {{"tested_points", stats.tested_points},
-                     {"dynamic_points", stats.dynamic_points},
-                     {"masked_keypoints", stats.masked_keypoints},
-                     {"culled_map_points", stats.culled_points},
-                     {"frames_without_mask", stats.frames_without_mask}};
-  json["mask_latency"] = {{"frames", to_json(mask_age)}, {"ms", to_json(mask_latency)}};
-  if (!live_masks.is_null()) json["live_masks"] = live_masks;
-  // The real-time targets from the camera's point of view: a frame is tracked before the
-  // next one arrives (arrival to pose, ms; empty without --realtime or a camera) and the mask it
-  // used is at most 2 frames old (frames between the masked frame and this one).
-  const LatencySummary arrival_to_pose = summarize_latency(stats.arrival_to_pose_ms);
-  json["latency"] = {{"arrival_to_pose_ms", to_json(arrival_to_pose)},
-                     {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
+    json["viewer_hooks_cpu"] = to_json(summarize(stats.observer_cpu_ms));
+  return json;
+}
+
+// The map, local mapping's window and the loops.
+void add_map_json(const RunReportInput& input, nlohmann::ordered_json& json) {
+  const MappingStats& mapping = input.mapping;
+  const SystemOptions& system = input.options.system;
   // How the threads shared the cores, to read beside the latency.
   json["scheduling"] = {{"background_thread_nice", system.background_thread_nice},
                         {"opencv_threads", cv::getNumThreads()},
@@ -398,9 +428,12 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
     json["loops"]["last_correction"] = {{"moved", mapping.last_loop_correction_m},
                                         {"resized", mapping.last_loop_correction_scale}};
   }
-  const std::pair<const char*, const std::optional<AteResult>*> ates[] = {
-      {"ate", &ate_tracked}, {"ate_refined", &ate_refined}};
-  for (const auto& [key, ate] : ates) {
+}
+
+void add_ate_json(const RunAte& ates, bool monocular, nlohmann::ordered_json& json) {
+  const std::pair<const char*, const std::optional<AteResult>*> evaluated[] = {
+      {"ate", &ates.tracked}, {"ate_refined", &ates.refined}};
+  for (const auto& [key, ate] : evaluated) {
     if (!*ate) continue;
     json[key] = {{"alignment", monocular ? "sim3" : "se3"},
                  {"scale", (*ate)->alignment.scale},
@@ -410,6 +443,69 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
                  {"max", (*ate)->error.max},
                  {"poses", (*ate)->error.count}};
   }
+}
+
+nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSections& reported) {
+  const RunStatistics& stats = input.statistics;
+  const SystemOptions& system = input.options.system;
+  const bool monocular = input.sensor == SensorType::monocular;
+  nlohmann::ordered_json json = run_json(input);
+  if (!reported.blackout.is_null()) json["blackout"] = reported.blackout;
+  if (input.requested_mode != system.dynamic.mode)
+    json["mode_requested"] = to_string(input.requested_mode);
+  if (monocular) json["monocular"] = monocular_json(stats, !system.map_file.empty());
+  json["lost_stretches"] = lost_stretches_json(stats);
+  json["realtime_dropped_frames"] = stats.realtime_dropped();
+  // How the input ended: a camera that was unplugged or fell silent says so here.
+  json["input"] = {{"dropped_frames", reported.source.dropped},
+                   {"disconnected", reported.source.disconnected},
+                   {"end_reason", reported.source.end_reason}};
+  json["seconds"] = input.seconds;
+  json["fps"] = input.seconds > 0 ? static_cast<double>(stats.processed()) / input.seconds : 0.0;
+  json["timing_ms"] = timing_json(stats, reported.timings);
+  json["dynamic"] = {{"tested_points", stats.tested_points},
+                     {"dynamic_points", stats.dynamic_points},
+                     {"masked_keypoints", stats.masked_keypoints},
+                     {"culled_map_points", stats.culled_points},
+                     {"frames_without_mask", stats.frames_without_mask}};
+  json["mask_latency"] = {{"frames", to_json(reported.timings.mask_age)},
+                          {"ms", to_json(reported.timings.mask_latency)}};
+  if (!reported.live_masks.is_null()) json["live_masks"] = reported.live_masks;
+  // The real-time targets from the camera's point of view: a frame is tracked before the
+  // next one arrives (arrival to pose, ms; empty without --realtime or a camera) and the mask it
+  // used is at most 2 frames old (frames between the masked frame and this one).
+  const LatencySummary arrival_to_pose = summarize_latency(stats.arrival_to_pose_ms);
+  json["latency"] = {{"arrival_to_pose_ms", to_json(arrival_to_pose)},
+                     {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
+  add_map_json(input, json);
+  add_ate_json(reported.ate, monocular, json);
+  return json;
+}
+
+}  // namespace
+
+void write_run_report(const RunReportInput& input, std::ostream& out) {
+  const std::filesystem::path& out_dir = input.options.outputs.folder;
+  const bool monocular = input.sensor == SensorType::monocular;
+  print_frames_and_map(input, out);
+  // A loaded map (--load-map) is there from the first frame: no two-view start to report.
+  const bool map_loaded = !input.options.system.map_file.empty();
+  if (monocular) print_monocular_start(input.statistics, map_loaded, out);
+  print_longest_lost_stretch(input.statistics, out);
+  out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
+      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv,\n"
+      << "              run_config.yaml (the config used)\n";
+  ReportedSections reported;
+  reported.ate = report_ate(input, monocular, out);
+  if (input.options.blackout)
+    reported.blackout = report_blackout(input, *input.options.blackout, reported.ate.tracked, out);
+  reported.timings = summarize_modules(input.statistics);
+  print_timing_and_dynamic(input, reported.timings, out);
+  reported.live_masks = report_live_masks(input, out);
+  reported.source = input.source.stats();
+  if (reported.source.disconnected) out << "input:        " << reported.source.end_reason << "\n";
+
+  const nlohmann::ordered_json json = stats_json(input, reported);
   std::ofstream file = open_output(out_dir / "stats.json");
   // Paths are not always UTF-8 (a Latin-1 folder name); replace invalid bytes instead of
   // throwing, so the summary is always written.

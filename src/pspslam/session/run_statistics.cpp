@@ -47,6 +47,21 @@ nlohmann::ordered_json to_json(const LatencySummary& latency) {
 
 void RunStatistics::add_frame(size_t index, const FrameReport& report, double local_ba_ms) {
   const TrackResult& result = report.tracking;
+  count_pose(index, result);
+  follow_lost_stretch(index, result);
+  add_timings(report, local_ba_ms);
+  const DynamicReport& dyn = report.dynamic;
+  add_live_masks(dyn);
+  if (result.pose_held) ++frames_pose_held;
+  tested_points += dyn.tested_points;
+  dynamic_points += dyn.dynamic_points;
+  masked_keypoints += dyn.masked_keypoints;
+  culled_points += dyn.culled_map_points;
+  ++processed_;
+}
+
+// Poses, relocalisations, the blackout's return and the (re)starts of the map.
+void RunStatistics::count_pose(size_t index, const TrackResult& result) {
   if (result.method == TrackingMethod::kRelocalisation) ++relocalisations_;
   if (blackout_ && index >= blackout_->end() && !first_pose_after_blackout_ &&
       result.T_world_camera) {
@@ -75,6 +90,10 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     if (result.T_world_camera) ++tracked_since_initialisation_;
   }
   if (result.restart_due) ++map_restarts_;
+}
+
+// The stretches of lost frames, and the longest of them.
+void RunStatistics::follow_lost_stretch(size_t index, const TrackResult& result) {
   if (result.state == TrackingState::kLost && !result.T_world_camera) {
     if (!current_lost_) {
       current_lost_ = LostStretch{index, index, 0};
@@ -94,7 +113,10 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     }
     current_lost_.reset();
   }
+}
 
+// Per-module milliseconds and the ages of the masks.
+void RunStatistics::add_timings(const FrameReport& report, double local_ba_ms) {
   if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
   extraction_ms.push_back(report.extraction_ms);
   tracking_ms.push_back(report.tracking_ms);
@@ -118,13 +140,6 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, double lo
     geometry_ms.push_back(dyn.geometry_ms);
     geometry_search_ms.push_back(dyn.geometry_search_ms);
   }
-  add_live_masks(dyn);
-  if (result.pose_held) ++frames_pose_held;
-  tested_points += dyn.tested_points;
-  dynamic_points += dyn.dynamic_points;
-  masked_keypoints += dyn.masked_keypoints;
-  culled_points += dyn.culled_map_points;
-  ++processed_;
 }
 
 void RunStatistics::add_live_masks(const DynamicReport& dynamic) {

@@ -111,6 +111,9 @@ class RunStatistics {
   int stale_mask_frames() const { return stale_mask_frames_; }
 
  private:
+  void count_pose(size_t index, const TrackResult& result);
+  void follow_lost_stretch(size_t index, const TrackResult& result);
+  void add_timings(const FrameReport& report, double local_ba_ms);
   void add_live_masks(const DynamicReport& dynamic);
 
   DynamicMode mode_;

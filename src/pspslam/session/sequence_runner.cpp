@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -13,6 +12,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/interrupt.h"
 #include "pspslam/core/progress.h"
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/io/input_frame.h"
 #include "pspslam/io/point_cloud_ply.h"
 #include "pspslam/io/sequence_source.h"
@@ -24,12 +24,6 @@
 
 namespace pspslam {
 namespace {
-
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 
 // --export-map / --export-dense, after shutdown (local mapping has refined the poses).
 void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, const Map& map,
@@ -46,6 +40,20 @@ void write_map_exports(const RunOutputs& outputs, const MapExporter& exporter, c
     out << "map export:   " << outputs.export_dense.string() << " (" << cloud.size()
         << " points, from " << exporter.remembered_keyframes() << " keyframe images)\n";
   }
+}
+
+void log_frame(const InputFrame& frame, const FrameReport& report) {
+  const TrackResult& result = report.tracking;
+  spdlog::debug(
+      "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "
+      "{} dynamic{}",
+      frame.index, frame.timestamp, to_string(result.state), to_string(result.method),
+      result.num_inliers, result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
+      report.dynamic.masked_keypoints, report.dynamic.tested_points, report.dynamic.dynamic_points,
+      result.initialization_matches > 0
+          ? fmt::format("; two-view: {} matches, {}", result.initialization_matches,
+                        to_string(result.initialization_model))
+          : std::string());
 }
 
 }  // namespace
@@ -144,18 +152,29 @@ void SequenceRunner::check_frame_size(const InputFrame& frame) const {
 }
 
 RunOutcome SequenceRunner::run() {
-  const bool realtime = options_.system.dynamic.realtime;
   InterruptGuard interrupt_guard;
   // A live stream of unknown length has no bar to fill.
-  ProgressBar progress("slam", frames_, std::cerr, options_.progress && frames_ > 0, realtime);
-  double ba_ms_before = 0.0;
+  ProgressBar progress("slam", frames_, std::cerr, options_.progress && frames_ > 0,
+                       options_.system.dynamic.realtime);
   const auto start = std::chrono::steady_clock::now();
-  // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
-  // network segments frame i+1 while frame i is tracked.
-  std::optional<InputFrame> next;
   // Frames before the first map: a sequence that never starts (no depth readings) is told why,
   // after a second of video and again at the end, instead of ending with 0 poses.
   StartWatch start_watch(static_cast<size_t>(std::max(1.0, input_.config.camera.fps)));
+  feed_frames(progress, start_watch);
+  if (observer_) observer_->run_ended();
+  progress.finish();
+  system_->shutdown();
+  save_map();
+  finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return outcome(start_watch);
+}
+
+void SequenceRunner::feed_frames(ProgressBar& progress, StartWatch& start_watch) {
+  const bool realtime = options_.system.dynamic.realtime;
+  double ba_ms_before = 0.0;
+  // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
+  // network segments frame i+1 while frame i is tracked.
+  std::optional<InputFrame> next;
   for (bool first = true; !interrupted(); first = false) {
     std::optional<InputFrame> current = next ? std::move(next) : next_frame();
     next.reset();
@@ -166,56 +185,10 @@ RunOutcome SequenceRunner::run() {
       if (first) system_->announce(frame);
       if (next) system_->announce(*next);
     }
-    const size_t i = frame.index;
     check_frame_size(frame);
-    double observer_cpu = 0.0;
-    if (observer_) {
-      const double cpu_before = thread_cpu_ms();
-      const RunObserver::Detail detail = observer_->wants_detail();
-      observer_cpu += thread_cpu_ms() - cpu_before;
-      const bool overlays = images_.writes_overlays();
-      system_->set_record_keypoint_fates(overlays || detail.fates,
-                                         overlays || detail.masked_keypoints);
-    }
+    const double observer_cpu = ask_observer_detail();
     const FrameReport report = system_->process(frame);
-    std::optional<double> arrival_to_pose_ms;
-    if (frame.arrival) {
-      arrival_to_pose_ms = std::chrono::duration<double, std::milli>(
-                               std::chrono::steady_clock::now() - *frame.arrival)
-                               .count();
-      statistics_.arrival_to_pose_ms.push_back(*arrival_to_pose_ms);
-    }
-    const TrackResult& result = report.tracking;
-    spdlog::debug(
-        "frame {} {:.6f}: {} ({}), {} of {} keypoints inliers{}; {} masked, {} tested, "
-        "{} dynamic{}",
-        i, frame.timestamp, to_string(result.state), to_string(result.method), result.num_inliers,
-        result.num_keypoints, result.keyframe_inserted ? ", new keyframe" : "",
-        report.dynamic.masked_keypoints, report.dynamic.tested_points,
-        report.dynamic.dynamic_points,
-        result.initialization_matches > 0
-            ? fmt::format("; two-view: {} matches, {}", result.initialization_matches,
-                          to_string(result.initialization_model))
-            : std::string());
-    write_images(frame, report);
-    if (exporter_ && result.keyframe_inserted)
-      exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
-                                   system_->last_dynamic_mask());
-    if (start_watch.update(result)) spdlog::warn("{}", start_watch.reason());
-    // The frame that started a monocular map also placed frames before it (oldest first).
-    estimate_.insert(estimate_.end(), result.earlier_frames.begin(), result.earlier_frames.end());
-    log_.write_earlier(result.earlier_frames);
-    if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
-    const MappingStats mapping = system_->mapping_stats();
-    const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
-    log_.write(i, frame.timestamp, report, local_ba_ms, mapping, arrival_to_pose_ms);
-    if (result.restart_due) {
-      // The new map has its own world frame and scale: the old poses would corrupt the file.
-      log_.forget_poses();
-      estimate_.clear();
-    }
-    statistics_.add_frame(i, report, mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
-    ba_ms_before = mapping.local_ba_ms_total;
+    const MappingStats mapping = record_frame(frame, report, start_watch, ba_ms_before);
     progress.update(statistics_.processed(), statistics_.realtime_dropped());
     if (observer_) {
       const double cpu_before = thread_cpu_ms();
@@ -223,17 +196,62 @@ RunOutcome SequenceRunner::run() {
       statistics_.observer_cpu_ms.push_back(observer_cpu + thread_cpu_ms() - cpu_before);
     }
   }
-  if (observer_) observer_->run_ended();
-  progress.finish();
-  system_->shutdown();
-  if (!options_.outputs.save_map.empty()) {
-    const std::filesystem::path& map_file = options_.outputs.save_map;
-    const auto [saved_keyframes, saved_points] = system_->save_map(map_file);
-    out_ << "map saved:    " << map_file.string() << " (" << saved_keyframes << " keyframes, "
-         << saved_points << " map points, " << std::filesystem::file_size(map_file) / 1024
-         << " KiB)\n";
+}
+
+double SequenceRunner::ask_observer_detail() {
+  if (!observer_) return 0.0;
+  const double cpu_before = thread_cpu_ms();
+  const RunObserver::Detail detail = observer_->wants_detail();
+  const double observer_cpu = thread_cpu_ms() - cpu_before;
+  const bool overlays = images_.writes_overlays();
+  system_->set_record_keypoint_fates(overlays || detail.fates, overlays || detail.masked_keypoints);
+  return observer_cpu;
+}
+
+MappingStats SequenceRunner::record_frame(const InputFrame& frame, const FrameReport& report,
+                                          StartWatch& start_watch, double& ba_ms_before) {
+  std::optional<double> arrival_to_pose_ms;
+  if (frame.arrival) {
+    arrival_to_pose_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - *frame.arrival)
+            .count();
+    statistics_.arrival_to_pose_ms.push_back(*arrival_to_pose_ms);
   }
-  finish(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  const TrackResult& result = report.tracking;
+  log_frame(frame, report);
+  write_images(frame, report);
+  if (exporter_ && result.keyframe_inserted)
+    exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
+                                 system_->last_dynamic_mask());
+  if (start_watch.update(result)) spdlog::warn("{}", start_watch.reason());
+  // The frame that started a monocular map also placed frames before it (oldest first).
+  estimate_.insert(estimate_.end(), result.earlier_frames.begin(), result.earlier_frames.end());
+  log_.write_earlier(result.earlier_frames);
+  if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
+  const MappingStats mapping = system_->mapping_stats();
+  const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
+  log_.write(frame.index, frame.timestamp, report, local_ba_ms, mapping, arrival_to_pose_ms);
+  if (result.restart_due) {
+    // The new map has its own world frame and scale: the old poses would corrupt the file.
+    log_.forget_poses();
+    estimate_.clear();
+  }
+  statistics_.add_frame(frame.index, report,
+                        mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
+  ba_ms_before = mapping.local_ba_ms_total;
+  return mapping;
+}
+
+void SequenceRunner::save_map() {
+  if (options_.outputs.save_map.empty()) return;
+  const std::filesystem::path& map_file = options_.outputs.save_map;
+  const auto [saved_keyframes, saved_points] = system_->save_map(map_file);
+  out_ << "map saved:    " << map_file.string() << " (" << saved_keyframes << " keyframes, "
+       << saved_points << " map points, " << std::filesystem::file_size(map_file) / 1024
+       << " KiB)\n";
+}
+
+RunOutcome SequenceRunner::outcome(const StartWatch& start_watch) {
   if (interrupted()) {
     out_ << "interrupted after " << statistics_.processed()
          << (frames_ > 0 ? " of " + std::to_string(frames_) : std::string())

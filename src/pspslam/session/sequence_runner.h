@@ -21,6 +21,8 @@
 namespace pspslam {
 
 struct InputFrame;
+class ProgressBar;
+class StartWatch;
 
 // What a run reads: its frames and the camera config they are processed with.
 struct RunInput {
@@ -58,8 +60,17 @@ class SequenceRunner {
   RunOutcome run();
 
  private:
+  // The frame loop: every frame processed, logged and shown to the observer.
+  void feed_frames(ProgressBar& progress, StartWatch& start_watch);
   std::optional<InputFrame> next_frame();
   void check_frame_size(const InputFrame& frame) const;
+  // Asks the observer what it shows of the next frame; returns the CPU milliseconds that took.
+  double ask_observer_detail();
+  // The frame's pose, log line, images and statistics; returns the mapping totals after it.
+  MappingStats record_frame(const InputFrame& frame, const FrameReport& report,
+                            StartWatch& start_watch, double& ba_ms_before);
+  void save_map();  // --save-map
+  RunOutcome outcome(const StartWatch& start_watch);
   void write_images(const InputFrame& frame, const FrameReport& report);
   void finish(double seconds);
 

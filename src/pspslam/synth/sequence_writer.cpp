@@ -296,26 +296,67 @@ void write_sequence(const SynthOptions& options, const fs::path& dir,
   write_sequence(scene, dir, progress);
 }
 
-void write_sequence(const SyntheticScene& scene, const fs::path& dir,
-                    const SynthProgress& progress) {
+namespace {
+
+void create_layout_folders(const SyntheticScene& scene, const fs::path& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
     throw Error("synth: --out " + dir.string() + " exists and is not a directory");
   }
-  const bool stereo = scene.options().stereo_baseline > 0.0;
-  const bool kitti = scene.options().layout == SynthOptions::Layout::kitti;
-  const bool euroc = scene.options().layout == SynthOptions::Layout::euroc;
   std::vector<const char*> folders = {"rgb", "depth", "mask"};
-  if (stereo) folders.push_back("right");
-  if (kitti) folders = {"image_0", "image_1"};
-  if (euroc) folders = {"mav0/cam0/data", "mav0/cam1/data", "mav0/state_groundtruth_estimate0"};
+  if (scene.options().stereo_baseline > 0.0) folders.push_back("right");
+  if (scene.options().layout == SynthOptions::Layout::kitti) folders = {"image_0", "image_1"};
+  if (scene.options().layout == SynthOptions::Layout::euroc)
+    folders = {"mav0/cam0/data", "mav0/cam1/data", "mav0/state_groundtruth_estimate0"};
   for (const char* sub : folders) {
     fs::create_directories(dir / sub, ec);
     if (ec) throw Error("synth: cannot create " + (dir / sub).string() + ": " + ec.message());
   }
+}
 
-  // Whole frames per worker (render single-threaded + encode): PNG encoding dominates and
-  // parallelises only across frames.
+// A worker's images, kept from frame to frame.
+struct FrameImages {
+  SynthFrame frame;
+  cv::Mat depth_u16, right, gray;
+};
+
+// Renders frame i and writes its images in the sequence's layout.
+void write_frame(const SyntheticScene& scene, size_t i, const fs::path& dir, FrameImages& images) {
+  const bool stereo = scene.options().stereo_baseline > 0.0;
+  SynthFrame& frame = images.frame;
+  scene.render(i, frame, 1);
+  if (stereo) {
+    scene.render_right(i, images.right, 1);
+    cv::cvtColor(images.right, images.right, cv::COLOR_BGR2GRAY);
+  }
+  if (scene.options().layout == SynthOptions::Layout::euroc) {
+    // EuRoC's cameras are grey too; file names are the nanosecond stamps.
+    const std::string name = euroc_stamp(scene.timestamp(i)) + ".png";
+    cv::cvtColor(frame.bgr, images.gray, cv::COLOR_BGR2GRAY);
+    write_png(dir / "mav0/cam0/data" / name, images.gray);
+    write_png(dir / "mav0/cam1/data" / name, images.right);
+  } else if (scene.options().layout == SynthOptions::Layout::kitti) {
+    // KITTI's odometry pair is grey: the left is the colour image's grey conversion, which
+    // is what the TUM-layout run extracts from, so both layouts track the same pixels.
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu.png", i);
+    cv::cvtColor(frame.bgr, images.gray, cv::COLOR_BGR2GRAY);
+    write_png(dir / "image_0" / name, images.gray);
+    write_png(dir / "image_1" / name, images.right);
+  } else {
+    const std::string name = format_timestamp(frame.timestamp) + ".png";
+    write_png(dir / "rgb" / name, frame.bgr);
+    frame.depth_sensor.convertTo(images.depth_u16, CV_16U, 5000.0);
+    write_png(dir / "depth" / (format_timestamp(depth_timestamp(scene, i)) + ".png"),
+              images.depth_u16);
+    write_png(dir / "mask" / name, frame.labels);
+    if (stereo) write_png(dir / "right" / name, images.right);
+  }
+}
+
+// Whole frames per worker (render single-threaded + encode): PNG encoding dominates and
+// parallelises only across frames. The first error stops the workers and is rethrown.
+void write_frames(const SyntheticScene& scene, const fs::path& dir, const SynthProgress& progress) {
   const size_t frames = scene.frame_count();
   const int requested = scene.options().threads;
   const size_t workers = std::max<size_t>(
@@ -330,38 +371,10 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   std::exception_ptr first_error;
 
   const auto worker = [&] {
-    SynthFrame frame;
-    cv::Mat depth_u16, right, gray;
+    FrameImages images;
     for (size_t i = next++; i < frames && !failed; i = next++) {
       try {
-        scene.render(i, frame, 1);
-        if (stereo) {
-          scene.render_right(i, right, 1);
-          cv::cvtColor(right, right, cv::COLOR_BGR2GRAY);
-        }
-        if (euroc) {
-          // EuRoC's cameras are grey too; file names are the nanosecond stamps.
-          const std::string name = euroc_stamp(scene.timestamp(i)) + ".png";
-          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-          write_png(dir / "mav0/cam0/data" / name, gray);
-          write_png(dir / "mav0/cam1/data" / name, right);
-        } else if (kitti) {
-          // KITTI's odometry pair is grey: the left is the colour image's grey conversion, which
-          // is what the TUM-layout run extracts from, so both layouts track the same pixels.
-          char name[32];
-          std::snprintf(name, sizeof(name), "%06zu.png", i);
-          cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-          write_png(dir / "image_0" / name, gray);
-          write_png(dir / "image_1" / name, right);
-        } else {
-          const std::string name = format_timestamp(frame.timestamp) + ".png";
-          write_png(dir / "rgb" / name, frame.bgr);
-          frame.depth_sensor.convertTo(depth_u16, CV_16U, 5000.0);
-          write_png(dir / "depth" / (format_timestamp(depth_timestamp(scene, i)) + ".png"),
-                    depth_u16);
-          write_png(dir / "mask" / name, frame.labels);
-          if (stereo) write_png(dir / "right" / name, right);
-        }
+        write_frame(scene, i, dir, images);
       } catch (...) {
         std::lock_guard lock(mutex);
         if (!first_error) first_error = std::current_exception();
@@ -391,19 +404,10 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   }
   for (std::thread& thread : pool) thread.join();
   if (first_error) std::rethrow_exception(first_error);
+}
 
-  write_ground_truth(dir, scene);
-  if (euroc) {
-    write_euroc_files(dir, scene);
-    write_info(dir, scene);
-    return;
-  }
-  if (kitti) {
-    // The camera comes from calib.txt; config.yaml would not be read in this layout.
-    write_kitti_files(dir, scene);
-    write_info(dir, scene);
-    return;
-  }
+// The TUM layout's frame lists, configs and notes.
+void write_tum_files(const fs::path& dir, const SyntheticScene& scene) {
   const auto colour_stamp = [&](size_t i) { return scene.timestamp(i); };
   write_frame_list(dir, "rgb.txt", "rgb", "color images", scene, colour_stamp);
   write_frame_list(dir, "depth.txt", "depth",
@@ -412,7 +416,7 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   write_frame_list(dir, "mask.txt", "mask",
                    "ground-truth labels (0 static, 15 person, 100 carried object)", scene,
                    colour_stamp);
-  if (stereo) {
+  if (scene.options().stereo_baseline > 0.0) {
     write_frame_list(dir, "right.txt", "right",
                      "rectified right images (8-bit grey) of the stereo pair", scene, colour_stamp);
     save_config(dir / "config_rgbd.yaml", scene.rgbd_system_config());
@@ -421,6 +425,27 @@ void write_sequence(const SyntheticScene& scene, const fs::path& dir,
   if (scene.options().sensor == SynthSensor::kKinect) write_body_to_camera(dir, scene);
   write_info(dir, scene);
   write_readme(dir, scene);
+}
+
+}  // namespace
+
+void write_sequence(const SyntheticScene& scene, const fs::path& dir,
+                    const SynthProgress& progress) {
+  create_layout_folders(scene, dir);
+  write_frames(scene, dir, progress);
+  write_ground_truth(dir, scene);
+  if (scene.options().layout == SynthOptions::Layout::euroc) {
+    write_euroc_files(dir, scene);
+    write_info(dir, scene);
+    return;
+  }
+  if (scene.options().layout == SynthOptions::Layout::kitti) {
+    // The camera comes from calib.txt; config.yaml would not be read in this layout.
+    write_kitti_files(dir, scene);
+    write_info(dir, scene);
+    return;
+  }
+  write_tum_files(dir, scene);
 }
 
 }  // namespace pspslam

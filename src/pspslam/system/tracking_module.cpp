@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 
 #include "pspslam/core/clock.h"
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/feature/orb_config.h"
 #include "pspslam/geometry/geometry_config.h"
 #include "pspslam/map/frame.h"
@@ -17,12 +17,6 @@
 
 namespace pspslam {
 namespace {
-
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 
 // The tracker's settings that follow from the camera: ORB-SLAM2 wants a keyframe at least once
 // per second of video, and pose optimisation weighs depth as bundle adjustment does.

@@ -197,70 +197,8 @@ void LiveViewer::frame_done(const FrameView& view) {
   lock.unlock();
 
   // The copies, outside the lock: the encoder may be busy with the snapshot before.
-  std::unique_ptr<FrameSnapshot> frame;
-  if (show) {
-    frame = std::make_unique<FrameSnapshot>();
-    FrameSnapshot& s = *frame;
-    s.index = view.frame.index;
-    s.timestamp = view.frame.timestamp;
-    s.total = view.frames_total;
-    s.bgr = view.frame.bgr;
-    s.labels = view.system.last_semantic_labels();
-    s.detail = detail;
-    s.keypoints = view.report.keypoints;
-    if (const GeometryPicture* picture = view.system.last_geometry_picture()) {
-      s.regions = picture->regions;  // already a copy of the stage's buffer
-      s.tested = picture->tested;
-      s.path = picture->path;
-    }
-    s.tracking = view.report.tracking;
-    s.extraction_ms = view.report.extraction_ms;
-    s.tracking_ms = view.report.tracking_ms;
-    s.local_ba_ms =
-        view.statistics.local_mapping_ms.empty() ? 0.0 : view.statistics.local_mapping_ms.back();
-    s.dynamic = view.report.dynamic;
-    s.mapping = view.mapping;
-    const RunStatistics& st = view.statistics;
-    s.processed = st.processed();
-    s.lost = st.lost();
-    s.relocalisations = st.relocalisations();
-    s.dropped = st.realtime_dropped();
-    s.masked = st.masked_keypoints;
-    s.tested_total = st.tested_points;
-    s.dynamic_total = st.dynamic_points;
-    s.culled = st.culled_points;
-    s.without_mask = st.frames_without_mask;
-    s.time = now;
-  }
-  std::unique_ptr<MapSnapshot> map;
-  if (map_due) {
-    map = std::make_unique<MapSnapshot>();
-    const Map& slam_map = view.system.map();
-    for (const auto& point : slam_map.map_points()) {
-      if (point->is_bad()) continue;
-      const Eigen::Vector3d p = point->position();
-      map->positions.insert(
-          map->positions.end(),
-          {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
-    }
-    std::unordered_map<std::uint64_t, int> index;
-    const auto keyframes = slam_map.keyframes();
-    for (const auto& keyframe : keyframes) {
-      if (keyframe->is_bad()) continue;
-      index[keyframe->id()] = static_cast<int>(map->keyframes.size());
-      map->keyframes.push_back(keyframe->T_world_camera());
-    }
-    for (const auto& keyframe : keyframes) {
-      const auto from = index.find(keyframe->id());
-      if (from == index.end()) continue;
-      for (const auto& other : keyframe->covisibles_with_min_weight(kCovisibilityWeight)) {
-        const auto to = index.find(other->id());
-        if (to != index.end() && to->second > from->second)
-          map->edges.push_back({from->second, to->second});
-      }
-    }
-    map->estimate = view.estimate;
-  }
+  std::unique_ptr<FrameSnapshot> frame = show ? snapshot_frame(view, detail, now) : nullptr;
+  std::unique_ptr<MapSnapshot> map = map_due ? snapshot_map(view) : nullptr;
 
   lock.lock();
   if (frame) {
@@ -277,9 +215,81 @@ void LiveViewer::frame_done(const FrameView& view) {
   // next frame, which records them (wants_detail() says so while paused): the held frame is
   // always shown whole.
   if (!paused_ || options_.realtime || !detail) return;
+  hold(lock, view.frame.index);
+}
+
+std::unique_ptr<LiveViewer::FrameSnapshot> LiveViewer::snapshot_frame(const FrameView& view,
+                                                                      bool detail,
+                                                                      Clock::time_point now) {
+  auto frame = std::make_unique<FrameSnapshot>();
+  FrameSnapshot& s = *frame;
+  s.index = view.frame.index;
+  s.timestamp = view.frame.timestamp;
+  s.total = view.frames_total;
+  s.bgr = view.frame.bgr;
+  s.labels = view.system.last_semantic_labels();
+  s.detail = detail;
+  s.keypoints = view.report.keypoints;
+  if (const GeometryPicture* picture = view.system.last_geometry_picture()) {
+    s.regions = picture->regions;  // already a copy of the stage's buffer
+    s.tested = picture->tested;
+    s.path = picture->path;
+  }
+  s.tracking = view.report.tracking;
+  s.extraction_ms = view.report.extraction_ms;
+  s.tracking_ms = view.report.tracking_ms;
+  s.local_ba_ms =
+      view.statistics.local_mapping_ms.empty() ? 0.0 : view.statistics.local_mapping_ms.back();
+  s.dynamic = view.report.dynamic;
+  s.mapping = view.mapping;
+  const RunStatistics& st = view.statistics;
+  s.processed = st.processed();
+  s.lost = st.lost();
+  s.relocalisations = st.relocalisations();
+  s.dropped = st.realtime_dropped();
+  s.masked = st.masked_keypoints;
+  s.tested_total = st.tested_points;
+  s.dynamic_total = st.dynamic_points;
+  s.culled = st.culled_points;
+  s.without_mask = st.frames_without_mask;
+  s.time = now;
+  return frame;
+}
+
+std::unique_ptr<LiveViewer::MapSnapshot> LiveViewer::snapshot_map(const FrameView& view) {
+  auto map = std::make_unique<MapSnapshot>();
+  const Map& slam_map = view.system.map();
+  for (const auto& point : slam_map.map_points()) {
+    if (point->is_bad()) continue;
+    const Eigen::Vector3d p = point->position();
+    map->positions.insert(
+        map->positions.end(),
+        {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
+  }
+  std::unordered_map<std::uint64_t, int> index;
+  const auto keyframes = slam_map.keyframes();
+  for (const auto& keyframe : keyframes) {
+    if (keyframe->is_bad()) continue;
+    index[keyframe->id()] = static_cast<int>(map->keyframes.size());
+    map->keyframes.push_back(keyframe->T_world_camera());
+  }
+  for (const auto& keyframe : keyframes) {
+    const auto from = index.find(keyframe->id());
+    if (from == index.end()) continue;
+    for (const auto& other : keyframe->covisibles_with_min_weight(kCovisibilityWeight)) {
+      const auto to = index.find(other->id());
+      if (to != index.end() && to->second > from->second)
+        map->edges.push_back({from->second, to->second});
+    }
+  }
+  map->estimate = view.estimate;
+  return map;
+}
+
+void LiveViewer::hold(std::unique_lock<std::mutex>& lock, size_t frame_index) {
   // Held between frames until resume or step; the poll lets Ctrl-C end a paused run.
   waiting_ = true;
-  held_frame_ = view.frame.index;
+  held_frame_ = frame_index;
   ++event_;
   changed_.notify_all();
   while (paused_ && steps_ == 0 && !closing_ && !interrupted())
@@ -396,6 +406,32 @@ void LiveViewer::publish_frame(const FrameSnapshot& s) {
                                    : encode(".png", region_picture(s.regions, size),
                                             {cv::IMWRITE_PNG_COMPRESSION, 1});
 
+  update_fps(s);
+  auto text = share(frame_json(s, labels != nullptr, regions != nullptr));
+
+  std::lock_guard lock(mutex_);
+  frame_json_ = std::move(text);
+  jpeg_ = std::move(jpeg);
+  labels_png_ = std::move(labels);
+  regions_png_ = std::move(regions);
+  ++frame_version_;
+  ++event_;
+  changed_.notify_all();
+}
+
+// fps over the snapshots: frames processed between two of them over the time between.
+void LiveViewer::update_fps(const FrameSnapshot& s) {
+  if (!fps_reference_ || s.processed < fps_reference_->first) {
+    fps_reference_.emplace(s.processed, s.time);
+  } else if (const double seconds =
+                 std::chrono::duration<double>(s.time - fps_reference_->second).count();
+             seconds >= 1.0) {
+    fps_ = (s.processed - fps_reference_->first) / seconds;
+    fps_reference_.emplace(s.processed, s.time);
+  }
+}
+
+std::string LiveViewer::frame_json(const FrameSnapshot& s, bool labels, bool regions) const {
   std::array<int, 4> fates{};
   json keypoints = json::array();
   for (const KeypointRecord& k : s.keypoints) {
@@ -408,14 +444,6 @@ void LiveViewer::publish_frame(const FrameSnapshot& s) {
   json path = json::array();
   for (const cv::Point2f& node : s.path) path.push_back({round1(node.x), round1(node.y)});
 
-  if (!fps_reference_ || s.processed < fps_reference_->first) {
-    fps_reference_.emplace(s.processed, s.time);
-  } else if (const double seconds =
-                 std::chrono::duration<double>(s.time - fps_reference_->second).count();
-             seconds >= 1.0) {
-    fps_ = (s.processed - fps_reference_->first) / seconds;
-    fps_reference_.emplace(s.processed, s.time);
-  }
   const DynamicReport& d = s.dynamic;
   const json frame = {
       {"index", s.index},
@@ -434,8 +462,8 @@ void LiveViewer::publish_frame(const FrameSnapshot& s) {
       {"fates", fates},
       {"tested", std::move(tested)},
       {"path", std::move(path)},
-      {"labels", labels != nullptr},
-      {"regions", regions != nullptr},
+      {"labels", labels},
+      {"regions", regions},
       {"timing",
        {{"extraction", round1(s.extraction_ms)},
         {"flow", round1(d.flow_ms)},
@@ -461,16 +489,7 @@ void LiveViewer::publish_frame(const FrameSnapshot& s) {
         {"culled_map_points", s.culled},
         {"frames_without_mask", s.without_mask},
         {"loops_closed", s.mapping.loops_closed}}}};
-  auto text = share(frame.dump());
-
-  std::lock_guard lock(mutex_);
-  frame_json_ = std::move(text);
-  jpeg_ = std::move(jpeg);
-  labels_png_ = std::move(labels);
-  regions_png_ = std::move(regions);
-  ++frame_version_;
-  ++event_;
-  changed_.notify_all();
+  return frame.dump();
 }
 
 void LiveViewer::publish_map(const MapSnapshot& s) {

@@ -70,8 +70,16 @@ class LiveViewer final : public RunObserver {
   struct MapSnapshot;
   using Clock = std::chrono::steady_clock;
 
+  static std::unique_ptr<FrameSnapshot> snapshot_frame(const FrameView& view, bool detail,
+                                                       Clock::time_point now);
+  static std::unique_ptr<MapSnapshot> snapshot_map(const FrameView& view);
+  // Holds the run loop after frame `frame_index` until resume, step, closing or an interrupt.
+  void hold(std::unique_lock<std::mutex>& lock, size_t frame_index);
   void encode_loop();
   void publish_frame(const FrameSnapshot& snapshot);
+  void update_fps(const FrameSnapshot& snapshot);
+  // The frame's JSON for the page; `labels` and `regions`: their pictures were encoded.
+  std::string frame_json(const FrameSnapshot& snapshot, bool labels, bool regions) const;
   void publish_map(const MapSnapshot& snapshot);
   std::string state_json() const;  // under mutex_
   std::string event_json() const;  // under mutex_: state + the newest frame's JSON

@@ -30,13 +30,10 @@
 
 #include "commands.h"
 #include "flag_checks.h"
-#include "pspslam/capture/camera_spec.h"
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/core/thread_priority.h"
-#include "pspslam/io/sequence_setup.h"
-#include "pspslam/io/video_source.h"
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/semantic/semantic_delay.h"
@@ -196,6 +193,8 @@ namespace {
 RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   RunOptions options;
   options.sequence = flags.sequence;
+  options.camera = flags.camera;
+  options.video = flags.video;
   if (!flags.config.empty()) options.config = flags.config;
   if (!flags.sensor.empty()) options.sensor = parse_sensor_type(flags.sensor, "--sensor");
   options.outputs.kitti_trajectory = flags.trajectory_format == "kitti";
@@ -214,29 +213,6 @@ RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
   return options;
-}
-
-// A live camera or a video with its config; none for a sequence folder (opened by the runner).
-std::optional<RunInput> open_camera_input(const RunFlags& flags,
-                                          const std::optional<SensorType>& sensor) {
-  std::optional<RunInput> camera;
-  if (!flags.camera.empty()) {
-    const CameraSpec spec = parse_camera_spec(flags.camera);
-    camera.emplace();
-    camera->config_file =
-        flags.config.empty() ? camera_config_preset(spec) : std::filesystem::path(flags.config);
-    camera->config = load_config(camera->config_file);
-    if (sensor) apply_sensor_override(camera->config, *sensor, camera->config_file);
-    camera->source = open_camera(spec);
-  }
-  if (!flags.video.empty()) {
-    camera.emplace();
-    camera->config_file = flags.config;
-    camera->config = load_config(camera->config_file);
-    apply_sensor_override(camera->config, SensorType::monocular, camera->config_file);
-    camera->source = open_video(flags.video, camera->config.camera.fps);
-  }
-  return camera;
 }
 
 // The viewer binds its address before the model and the sequence load, so a port in use is
@@ -293,14 +269,17 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     cv::setNumThreads(1);
   set_cli_only_options(flags, system);
 
-  std::optional<RunInput> camera = open_camera_input(flags, options.sensor);
+  // A sequence opens in the runner, after the viewer has bound its address; a camera or video
+  // opens first, so that a live source can set what the run waits for.
+  std::optional<RunInput> live;
+  if (flags.sequence.empty()) live = open_run_input(options);
   // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
   // second of frames, so a live run without --realtime waits for local mapping only.
-  if (!flags.realtime && camera && camera->source->live())
+  if (!flags.realtime && live && live->source->live())
     system.back_end_wait = BackEndWait::local_mapping;
   std::unique_ptr<LiveViewer> viewer = start_viewer(flags, system);
-  SequenceRunner runner = camera ? SequenceRunner(std::move(*camera), std::move(options), std::cout)
-                                 : SequenceRunner(std::move(options), std::cout);
+  SequenceRunner runner = live ? SequenceRunner(std::move(*live), std::move(options), std::cout)
+                               : SequenceRunner(std::move(options), std::cout);
   runner.watch(viewer.get());
   return exit_status(runner.run());
 }

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "pspslam/io/sequence_source.h"
 #include "pspslam/system/system.h"
@@ -37,10 +38,14 @@ struct RunOutputs {
 // run never computes for minutes and then fails to write. Errors name the CLI flag of the path.
 void prepare_run_outputs(const RunOutputs& outputs);
 
-// One run of the system over a recorded sequence (`pspslam run`).
+// One run of the system (`pspslam run`).
 struct RunOptions {
-  std::filesystem::path sequence;  // read by SequenceRunner(RunOptions, ...) only
-  // Config YAML; none: SEQUENCE/config.yaml (io/sequence_setup.h).
+  // The input, one of three (session/run_input.h opens it): a recorded sequence folder, a live
+  // camera (`--camera freenect[:INDEX]`) or a video file or camera index (`--video`).
+  std::filesystem::path sequence;
+  std::string camera;
+  std::string video;
+  // Config YAML; none: SEQUENCE/config.yaml (io/sequence_setup.h) or the camera's preset.
   std::optional<std::filesystem::path> config;
   // `pspslam run --sensor`: overrides the config's camera.type (io/sequence_setup.h).
   std::optional<SensorType> sensor;

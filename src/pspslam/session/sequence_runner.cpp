@@ -58,19 +58,8 @@ void log_frame(const InputFrame& frame, const FrameReport& report) {
 
 }  // namespace
 
-RunInput open_sequence_input(const RunOptions& options) {
-  SequenceSetup setup = open_sequence_with_config(
-      options.sequence, options.config,
-      spdlog::should_log(spdlog::level::warn) ? &std::cerr : nullptr, options.sensor);
-  check_config_sections(setup.config);  // before a preload decodes every frame
-  RunInput input{setup.config_file, setup.config, nullptr};
-  input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
-                                                  options.system.dynamic.realtime, options.preload);
-  return input;
-}
-
 SequenceRunner::SequenceRunner(RunOptions options, std::ostream& out)
-    : SequenceRunner(open_sequence_input(options), options, out) {}
+    : SequenceRunner(open_run_input(options), options, out) {}
 
 SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream& out)
     : options_(std::move(options)),

@@ -11,6 +11,7 @@
 #include "pspslam/io/frame_source.h"
 #include "pspslam/session/frame_images.h"
 #include "pspslam/session/frame_log.h"
+#include "pspslam/session/run_input.h"
 #include "pspslam/session/run_observer.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
@@ -24,17 +25,6 @@ struct InputFrame;
 class ProgressBar;
 class StartWatch;
 
-// What a run reads: its frames and the camera config they are processed with.
-struct RunInput {
-  std::filesystem::path config_file;
-  SystemConfig config;
-  std::unique_ptr<FrameSource> source;
-};
-
-// options.sequence opened with its config (io/sequence_setup.h) as a SequenceSource, paced when
-// options.system.dynamic.realtime.
-RunInput open_sequence_input(const RunOptions& options);
-
 // Runs the System over a stream of frames and writes the run's files (`pspslam run`): the
 // per-frame log (frame_log.h) while it goes, then keyframes.txt, trajectory_refined.txt, the map
 // files asked for and the report (run_report.h). Frames are fed as a deterministic run wants
@@ -43,7 +33,7 @@ RunInput open_sequence_input(const RunOptions& options);
 // in time). Where the frames come from is the FrameSource's business.
 class SequenceRunner {
  public:
-  // Opens options.sequence (open_sequence_input) and runs over it.
+  // Opens the input options names (open_run_input) and runs over it.
   SequenceRunner(RunOptions options, std::ostream& out);
   // Creates the per-frame files and the System for `input`; prints the setup to `out`. Call
   // prepare_run_outputs() first. Throws pspslam::Error.

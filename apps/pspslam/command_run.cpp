@@ -94,6 +94,7 @@ struct RunFlags {
   std::string trajectory_format = "tum";
   std::string out = "pspslam_out";
   size_t max_frames = 0;
+  size_t start_frame = 0;
   bool no_local_mapping = false;
   std::string dynamic = "auto";
   std::string model;           // empty: the shipped model
@@ -199,6 +200,7 @@ RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   if (!flags.sensor.empty()) options.sensor = parse_sensor_type(flags.sensor, "--sensor");
   options.outputs.kitti_trajectory = flags.trajectory_format == "kitti";
   options.max_frames = flags.max_frames;
+  options.start_frame = flags.start_frame;
   options.preload = flags.preload == "on"    ? Preload::on
                     : flags.preload == "off" ? Preload::off
                                              : Preload::automatic;
@@ -325,6 +327,12 @@ CLI::Option* add_input_options(CLI::App* app, const std::shared_ptr<RunFlags>& f
   app->add_option("--out", flags->out, "output folder")->capture_default_str();
   app->add_option("--max-frames", flags->max_frames, "process at most this many frames (0 = all)")
       ->check(in_range(size_t{0}, size_t{1000000000}))
+      ->capture_default_str();
+  app->add_option("--start-frame", flags->start_frame,
+                  "start a sequence at this frame (0 = the first), skipping those before it; "
+                  "frames keep their sequence positions in the outputs")
+      ->check(in_range(size_t{0}, size_t{1000000000}))
+      ->needs(sequence)
       ->capture_default_str();
   app->add_flag("--no-local-mapping", flags->no_local_mapping,
                 "track only: keyframes enter the map but are never refined (debugging)");

@@ -95,6 +95,7 @@ row "--keyframe-ratio 0" 2 -- $R --sequence seq --keyframe-ratio 0
 row "--keyframe-ratio abc" 2 -- $R --sequence seq --keyframe-ratio abc
 row "--max-frames -3" 2 -- $R --sequence seq --max-frames -3
 row "--max-frames 1e3" 2 -- $R --sequence seq --max-frames 1e3
+row "--start-frame past the end" 2 -- $R --sequence seq --start-frame 12
 row "--blackout 3 (no count)" 2 -- $R --sequence seq --blackout 3
 row "--blackout 5:0" 2 -- $R --sequence seq --blackout 5:0
 row "--loop-closing maybe" 2 -- $R --sequence seq --loop-closing maybe

@@ -372,6 +372,34 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
   }
 }
 
+// --start-frame skips the frames before it: the run tracks the rest, from a map started there,
+// and the frames keep their sequence positions; a start beyond the sequence is an error.
+TEST(CliRun, StartFrameSkipsTheFramesBeforeIt) {
+  const auto dir = testing::make_temp_dir("cli_start_frame");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 45 --bodies 0 --seed 2");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const std::string run = "run --sequence " + (dir / "seq").string() + " --dynamic off";
+  Result r = pspslam(run + " --start-frame 20 --out " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "start:        frame 20 (--start-frame; 20 frames skipped)"))
+      << r.output;
+  const Trajectory online = read_tum_trajectory(dir / "out" / "trajectory.txt");
+  const Trajectory truth = read_tum_trajectory(dir / "seq" / "groundtruth.txt");
+  ASSERT_EQ(online.size(), 25u);
+  EXPECT_DOUBLE_EQ(online.front().timestamp, truth[20].timestamp);
+  EXPECT_DOUBLE_EQ(online.back().timestamp, truth[44].timestamp);
+  EXPECT_LT(compute_ate(truth, online).error.rmse, 0.01);
+  const nlohmann::json stats = nlohmann::json::parse(read_text(dir / "out" / "stats.json"));
+  EXPECT_EQ(stats["frames"], 25) << stats.dump();
+
+  r = pspslam(run + " --start-frame 45 --out " + (dir / "beyond").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "error: --start-frame 45: " + (dir / "seq").string() +
+                                     " holds 45 frames (0 .. 44)"))
+      << r.output;
+}
+
 // Every run writes the config it used: OUT/run_config.yaml repeats the run exactly (here with a
 // geometry: section and a --sensor override, which it carries), and stats.json names the config
 // file and the binary's version.

@@ -21,21 +21,27 @@ size_t frame_bytes(const InputFrame& frame) {
 
 }  // namespace
 
-SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool paced, Preload preload)
-    : setup_(std::move(setup)),
-      frames_(max_frames == 0 ? setup_.sequence->size()
-                              : std::min(setup_.sequence->size(), max_frames)),
-      paced_(paced) {
+SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool paced, Preload preload,
+                               size_t first_frame)
+    : setup_(std::move(setup)), first_(first_frame), paced_(paced) {
+  const size_t size = setup_.sequence->size();
+  if (first_ >= size) {
+    throw Error("--start-frame " + std::to_string(first_) + ": " +
+                setup_.sequence->directory().string() + " holds " + std::to_string(size) +
+                " frames (0 .. " + std::to_string(size - 1) + ")");
+  }
+  end_ = max_frames == 0 ? size : std::min(size, first_ + max_frames);
+  frames_ = end_ - first_;
   if (preload == Preload::on && !paced_)
     throw Error("--preload: only a --realtime run replays at the camera's rate");
   if (paced_ && preload != Preload::off && frames_ > 0) {
-    InputFrame first = setup_.sequence->load(0);
+    InputFrame first = setup_.sequence->load(first_);
     const double need = static_cast<double>(frame_bytes(first)) * static_cast<double>(frames_);
     const size_t limit = preload == Preload::on ? kPreloadLimitBytes : kAutoPreloadBytes;
     if (need <= static_cast<double>(limit)) {
       preloaded_.reserve(frames_);
       preloaded_.push_back(std::move(first));
-      for (size_t index = 1; index < frames_; ++index)
+      for (size_t index = first_ + 1; index < end_; ++index)
         preloaded_.push_back(setup_.sequence->load(index));
       preloaded_bytes_ = static_cast<size_t>(need);
     } else if (preload == Preload::on) {
@@ -66,23 +72,24 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
     if (!start_cv_.wait(lock, stop, [this] { return start_.has_value(); })) return;
     start = *start_;
   }
-  const Timestamp t0 = frames_ > 0 ? sequence.timestamp(0) : 0.0;
+  const Timestamp t0 = frames_ > 0 ? sequence.timestamp(first_) : 0.0;
   try {
     const auto due_time = [&](size_t index) {
       return start + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(sequence.timestamp(index) - t0));
     };
-    for (size_t index = 0; index < frames_ && !stop.stop_requested(); ++index) {
+    for (size_t index = first_; index < end_ && !stop.stop_requested(); ++index) {
       // A camera does not queue what it could not deliver: when the reader itself is late
       // (decoding competes for the cores), it goes on with the newest frame already due.
       const auto now = Clock::now();
       size_t newest = index;
-      while (newest + 1 < frames_ && due_time(newest + 1) <= now) ++newest;
+      while (newest + 1 < end_ && due_time(newest + 1) <= now) ++newest;
       skipped_ += newest - index;
       index = newest;
       // Decoded ahead, delivered when due; one that is late when decoded is delivered at once,
       // and that lateness counts in its latency (its arrival stays the due time).
-      InputFrame frame = preloaded_.empty() ? sequence.load(index) : std::move(preloaded_[index]);
+      InputFrame frame =
+          preloaded_.empty() ? sequence.load(index) : std::move(preloaded_[index - first_]);
       const auto due = due_time(index);
       {
         std::unique_lock lock(start_mutex_);
@@ -103,7 +110,8 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
 
 std::optional<InputFrame> SequenceSource::next() {
   if (!paced_) {
-    if (next_index_ >= frames_) return std::nullopt;
+    if (next_index_ < first_) next_index_ = first_;
+    if (next_index_ >= end_) return std::nullopt;
     return setup_.sequence->load(next_index_++);
   }
   {
@@ -124,6 +132,10 @@ std::optional<InputFrame> SequenceSource::next() {
 
 std::string SequenceSource::describe() const {
   std::string text = describe_sequence(setup_);
+  if (first_ > 0) {
+    text += "start:        frame " + std::to_string(first_) + " (--start-frame; " +
+            std::to_string(first_) + " frames skipped)\n";
+  }
   if (paced_) {
     std::ostringstream line;
     line << "replay:       paced at the recording's rate; ";

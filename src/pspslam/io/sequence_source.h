@@ -38,9 +38,11 @@ class SequenceSource final : public FrameSource {
   static constexpr size_t kPreloadLimitBytes = size_t{8} << 30;
   static constexpr size_t kAutoPreloadBytes = size_t{2} << 30;  // the complete Bonn clip fits
 
-  // `max_frames` 0 = all.
-  SequenceSource(SequenceSetup setup, size_t max_frames, bool paced,
-                 Preload preload = Preload::off);
+  // Frames `first_frame` .. `first_frame + max_frames - 1` of the sequence (`max_frames` 0 = to
+  // the end); each keeps its position in the sequence as InputFrame::index. Throws
+  // pspslam::Error when the sequence holds no frame `first_frame`.
+  SequenceSource(SequenceSetup setup, size_t max_frames, bool paced, Preload preload = Preload::off,
+                 size_t first_frame = 0);
   ~SequenceSource() override;  // stops and joins the reader
   SequenceSource(const SequenceSource&) = delete;
   SequenceSource& operator=(const SequenceSource&) = delete;
@@ -65,9 +67,11 @@ class SequenceSource final : public FrameSource {
   void read_paced(const std::stop_token& stop);
 
   SequenceSetup setup_;
-  size_t frames_ = 0;
+  size_t first_ = 0;  // the frames played: [first_, end_) of the sequence
+  size_t end_ = 0;
+  size_t frames_ = 0;  // end_ - first_
   bool paced_ = false;
-  size_t next_index_ = 0;              // deterministic reading
+  size_t next_index_ = 0;              // deterministic reading (from first_)
   std::vector<InputFrame> preloaded_;  // --preload: every frame, decoded before the run
   size_t preloaded_bytes_ = 0;
   LatestQueue<InputFrame> delivered_{1};

@@ -22,7 +22,8 @@ RunInput open_sequence(const RunOptions& options) {
   check_config_sections(setup.config);  // before a preload decodes every frame
   RunInput input{setup.config_file, setup.config, nullptr};
   input.source = std::make_unique<SequenceSource>(std::move(setup), options.max_frames,
-                                                  options.system.dynamic.realtime, options.preload);
+                                                  options.system.dynamic.realtime, options.preload,
+                                                  options.start_frame);
   return input;
 }
 

@@ -49,6 +49,8 @@ struct RunOptions {
   std::optional<std::filesystem::path> config;
   // `pspslam run --sensor`: overrides the config's camera.type (io/sequence_setup.h).
   std::optional<SensorType> sensor;
+  // A recorded sequence starts at this frame (`--start-frame`; frames keep their positions).
+  size_t start_frame = 0;
   size_t max_frames = 0;  // 0 = all
   // `pspslam run --preload` (with --realtime): decode every frame before the paced replay starts
   // (io/sequence_source.h).

@@ -24,14 +24,7 @@
 namespace pspslam {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::error_of;
 
 TEST(KinectDepth, RawAndMetresRoundTripWithinOneDisparityStep) {
   EXPECT_EQ(kinect_raw_to_metres(kKinectRawNoReading), 0.0f);

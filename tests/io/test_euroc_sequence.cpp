@@ -18,6 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using testing::error_of;
 using testing::write_text;
 
 constexpr int kWidth = 200;
@@ -72,16 +73,6 @@ fs::path make_euroc(const std::string& tag, int frames = 3) {
   }
   write_text(mav / "state_groundtruth_estimate0" / "data.csv", gt);
   return dir;
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 SequenceOptions quiet() {

@@ -16,6 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using testing::error_of;
 using testing::write_text;
 
 constexpr const char* kCalibration =
@@ -42,16 +43,6 @@ fs::path make_kitti(const std::string& tag, int frames = 3) {
   write_text(dir / "poses.txt", poses);
   write_text(dir / "calib.txt", kCalibration);
   return dir;
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 SequenceOptions quiet() {

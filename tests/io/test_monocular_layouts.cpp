@@ -15,6 +15,8 @@
 namespace pspslam {
 namespace {
 
+using testing::error_of;
+
 namespace fs = std::filesystem;
 
 constexpr size_t kFrames = 6;
@@ -34,16 +36,6 @@ fs::path write_layout(SynthOptions::Layout layout, const std::string& tag) {
   const fs::path dir = testing::make_temp_dir(tag) / "seq";
   write_sequence(stereo_layout(layout), dir);
   return dir;
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 // What every monocular reading of a synthetic stereo folder must give.

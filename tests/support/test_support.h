@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <string>
 
+#include "pspslam/core/error.h"
+
 namespace pspslam::testing {
 
 // The ../shared folder, or std::nullopt-like empty path when it is absent.
@@ -26,6 +28,17 @@ int run_shell(const std::string& command, std::string* output);
 // A whole text file ("" when it cannot be read), and a file written with `text`.
 std::string read_text(const std::filesystem::path& file);
 void write_text(const std::filesystem::path& file, const std::string& text);
+
+// The message of the pspslam::Error that `call()` throws, or "(no error)".
+template <typename Call>
+std::string error_of(Call&& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
 
 inline bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;

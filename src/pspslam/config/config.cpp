@@ -163,17 +163,22 @@ std::string to_string(SensorType type) {
 
 namespace {
 
+// A module's section, kept for the module to read: its keys are the module's to check; here it
+// must only be a mapping (YamlSection::section refuses anything else, naming the line).
+ConfigSection module_section(YamlSection& top, const YAML::Node& root, const std::string& name,
+                             const std::string& key) {
+  top.section(key);
+  const YAML::Node node = root[key];
+  return node && node.IsMap() ? ConfigSection(node, name, key) : ConfigSection();
+}
+
 SystemConfig read_config(const YAML::Node& root, const std::string& name) {
   YamlSection top(root, name, "");
   if (!top.contains("camera")) throw Error(name + ": missing key 'camera'");
   SystemConfig config;
   config.camera = read_camera(top.section("camera"));
-  for (const char* key : {"orb", "geometry"}) {
-    top.section(key);  // its keys are the module's to read; here it must only be a mapping
-  }
-  if (root["orb"] && root["orb"].IsMap()) config.orb = ConfigSection(root["orb"], name, "orb");
-  if (root["geometry"] && root["geometry"].IsMap())
-    config.geometry = ConfigSection(root["geometry"], name, "geometry");
+  config.orb = module_section(top, root, name, "orb");
+  config.geometry = module_section(top, root, name, "geometry");
   top.finish();
   return config;
 }

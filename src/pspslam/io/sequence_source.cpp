@@ -32,6 +32,7 @@ SequenceSource::SequenceSource(SequenceSetup setup, size_t max_frames, bool pace
   }
   end_ = max_frames == 0 ? size : std::min(size, first_ + max_frames);
   frames_ = end_ - first_;
+  next_index_ = first_;
   if (preload == Preload::on && !paced_)
     throw Error("--preload: only a --realtime run replays at the camera's rate");
   if (paced_ && preload != Preload::off && frames_ > 0) {
@@ -110,7 +111,6 @@ void SequenceSource::read_paced(const std::stop_token& stop) {
 
 std::optional<InputFrame> SequenceSource::next() {
   if (!paced_) {
-    if (next_index_ < first_) next_index_ = first_;
     if (next_index_ >= end_) return std::nullopt;
     return setup_.sequence->load(next_index_++);
   }

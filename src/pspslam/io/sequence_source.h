@@ -71,7 +71,7 @@ class SequenceSource final : public FrameSource {
   size_t end_ = 0;
   size_t frames_ = 0;  // end_ - first_
   bool paced_ = false;
-  size_t next_index_ = 0;              // deterministic reading (from first_)
+  size_t next_index_ = 0;              // deterministic reading
   std::vector<InputFrame> preloaded_;  // --preload: every frame, decoded before the run
   size_t preloaded_bytes_ = 0;
   LatestQueue<InputFrame> delivered_{1};

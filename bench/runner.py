@@ -26,7 +26,7 @@ from pspbench.jobs import read_result  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 # Bumped when what a result holds changes, so older results are not read as current ones.
-RESULT_FORMAT = 1
+RESULT_FORMAT = 2
 
 
 def log(message):

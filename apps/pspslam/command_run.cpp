@@ -115,7 +115,8 @@ struct RunFlags {
   std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
-  int local_ba_keyframes = -1;       // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
+  int local_ba_keyframes = -1;  // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
+  double ba_tracking_factors = 0.0;
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
   std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
@@ -160,6 +161,7 @@ RunSettings run_settings(const RunFlags& flags) {
   settings.keyframe_ratio = flags.keyframe_ratio;
   settings.due_keyframes = flags.due_keyframes;
   if (flags.local_ba_keyframes >= 0) settings.local_ba_keyframes = flags.local_ba_keyframes;
+  settings.ba_tracking_factors = flags.ba_tracking_factors;
   if (flags.background_nice >= 0) settings.background_nice = flags.background_nice;
   if (flags.motion_prior.size() == 2)
     settings.motion_prior = std::pair(flags.motion_prior[0], flags.motion_prior[1]);
@@ -472,6 +474,12 @@ void add_keyframe_options(CLI::App* app, RunFlags& flags) {
                       " with --realtime or --camera, so that local BA keeps up on two cores; 0 "
                       "otherwise)")
       ->check(in_range(0, 1000));
+  app->add_option("--ba-tracking-factors", flags.ba_tracking_factors,
+                  "WEIGHT: local BA also keeps each keyframe's pose relative to the keyframe "
+                  "before it as tracking measured it, weighted by WEIGHT times the information "
+                  "of its pose-only optimisation (0 = off, ORB-SLAM2's BA)")
+      ->check(in_range(0.0, 1e6))
+      ->capture_default_str();
   app->add_flag("--due-keyframes", flags.due_keyframes,
                 "also make a keyframe once a second has passed since the last one, whatever "
                 "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "

@@ -74,6 +74,7 @@ class Experiment:
     mode: str  # the --dynamic mode of a run whose variant and cell name none
     spread_variant: str | None
     columns: dict
+    keyframe_table: bool
     cells: list
     variants: list
 
@@ -290,7 +291,8 @@ def load(path):
         description=fields.get("description", str, "").strip(), kind=kind,
         exclusive=fields.get("exclusive", bool, False), repeats=fields.get_count("repeats", 1),
         metric=fields.get_choice("metric", METRICS, "online"), base=base, mode=mode,
-        spread_variant=spread_variant, columns=dict(columns), cells=_read_cells(fields, kind),
+        spread_variant=spread_variant, columns=dict(columns),
+        keyframe_table=fields.get("keyframe_table", bool, False), cells=_read_cells(fields, kind),
         variants=variants)
     fields.reject_unknown()
     return experiment

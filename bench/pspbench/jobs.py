@@ -93,12 +93,27 @@ def measure_slam(job, attempt):
     _execute(command, attempt, job["cwd"], job["env"])
     run = attempt / "run"
     stats = json.loads((run / "stats.json").read_text())
+    _online_at_keyframes(run)
     files = {"online": "trajectory.txt", "final": "trajectory_refined.txt",
-             "keyframes": "keyframes.txt"}
+             "keyframes": "keyframes.txt", "online_at_keyframes": "online_at_keyframes.txt"}
     evaluations = {stretch["id"]: {label: _ate(job["command"][0], stretch, run / name)
                                    for label, name in files.items()}
                    for stretch in job["stretches"]}
     return {"stats": stats, "evaluations": evaluations}
+
+
+def _online_at_keyframes(run):
+    """run/online_at_keyframes.txt: the lines of trajectory.txt at the stamps of keyframes.txt,
+    the online poses to hold the keyframes after bundle adjustment against."""
+    def lines(name):
+        path = run / name
+        if not path.exists():
+            return []
+        return [line for line in path.read_text().splitlines()
+                if line.strip() and not line.startswith("#")]
+    stamps = {line.split()[0] for line in lines("keyframes.txt")}
+    kept = [line for line in lines("trajectory.txt") if line.split()[0] in stamps]
+    (run / "online_at_keyframes.txt").write_text("".join(line + "\n" for line in kept))
 
 
 def _ate(cli, stretch, estimate):

@@ -102,6 +102,8 @@ def slam_tables(experiment, table):
              f"{experiment.repeats} run{'s' if experiment.repeats > 1 else ''}"
              f"{' [lowest–highest]' if experiment.repeats > 1 else ''}.", ""] + lines
     lines += [""] + summary_table(experiment, table)
+    if experiment.keyframe_table:
+        lines += [""] + keyframe_table(experiment, table)
     lines += [""] + paired_tables(experiment, table)
     if experiment.columns:
         lines += [""] + column_table(experiment, table)
@@ -132,6 +134,39 @@ def summary_table(experiment, table):
                 for which, s in spread.items()}
         lines.append(f"| {variant.name} | {len(medians['online'])} | {text['online']} | "
                      f"{text['final']} | {not_worse} of {len(medians['online'])} |")
+    return lines
+
+
+def keyframe_table(experiment, table):
+    """Per cell and variant: the keyframes after bundle adjustment against the online poses at
+    the same stamps (does BA improve on what tracking had?), and the final file against the
+    online one."""
+    variants = [v.name for v in experiment.variants]
+    lines = ["Keyframes after bundle adjustment / the online poses at the same stamps (mm, "
+             "median over runs; ✓ where BA left them closer to the truth), then final − online "
+             "(mm):", "", f"| cell | {' | '.join(variants)} |", "|---|" + "---|" * len(variants)]
+    tally = {variant: [0, 0] for variant in variants}
+    for cell in experiment.cells:
+        entries = []
+        for variant in variants:
+            runs = table[cell.name][variant]
+            if runs.missing:
+                entries.append("missing")
+                continue
+            kf, on_kf, online, final = (
+                stats.summarise(ate_values(runs, cell.name, which)).median
+                for which in ("keyframes", "online_at_keyframes", "online", "final"))
+            if None in (kf, on_kf, online, final):
+                entries.append("—")
+                continue
+            better = kf < on_kf
+            tally[variant][0] += better
+            tally[variant][1] += 1
+            entries.append(f"{millimetres(kf)} / {millimetres(on_kf)} {'✓' if better else '✗'} · "
+                           f"{signed_millimetres(final - online)}")
+        lines.append(f"| {cell.name} | {' | '.join(entries)} |")
+    lines.append("| keyframes closer | " + " | ".join(f"{better} of {cells}" for better, cells
+                                                     in tally.values()) + " |")
     return lines
 
 

@@ -372,6 +372,42 @@ TEST(CliRun, KeyframeRatioSetsTheKeyframeDensity) {
   }
 }
 
+// --ba-tracking-factors: local BA keeps tracking's relative poses between keyframes; the summary
+// and stats.json say so, the run stays accurate, and local BA's CPU time is reported beside its
+// wall time (never above it: Ceres runs on the local mapping thread). A negative weight is refused.
+TEST(CliRun, TrackingFactorsJoinLocalBundleAdjustment) {
+  const auto dir = testing::make_temp_dir("cli_tracking_factors");
+  const Result synth =
+      pspslam("synth --out " + (dir / "seq").string() + " --frames 90 --bodies 0 --seed 4");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  const Result r = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                           (dir / "out").string() + " --dynamic off --ba-tracking-factors 0.5");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output,
+                       "local BA window: every covisible keyframe, with tracking's "
+                       "factors (weight 0.5)\n"))
+      << r.output;
+  std::ifstream in(dir / "out" / "stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  EXPECT_EQ(stats["scheduling"]["ba_tracking_factors"].get<double>(), 0.5);
+  const nlohmann::json& timing = stats["timing_ms"];
+  EXPECT_GT(timing["local_mapping_cpu"]["count"].get<int>(), 3);
+  EXPECT_EQ(timing["local_mapping_cpu"]["count"], timing["local_mapping"]["count"]);
+  EXPECT_LE(timing["local_mapping_cpu"]["median"].get<double>(),
+            timing["local_mapping"]["median"].get<double>() + 0.5);
+  EXPECT_LT(compute_ate(read_tum_trajectory(dir / "seq" / "groundtruth.txt"),
+                        read_tum_trajectory(dir / "out" / "trajectory.txt"))
+                .error.rmse,
+            0.01);
+
+  const Result bad = pspslam("run --sequence " + (dir / "seq").string() + " --out " +
+                             (dir / "bad").string() + " --ba-tracking-factors -1");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.output,
+            "error: pspslam run: --ba-tracking-factors: must be a number in [0, 1e+06], got '-1' "
+            "(see 'pspslam run --help')\n");
+}
+
 // --start-frame skips the frames before it: the run tracks the rest, from a map started there,
 // and the frames keep their sequence positions; a start beyond the sequence is an error.
 TEST(CliRun, StartFrameSkipsTheFramesBeforeIt) {

@@ -140,7 +140,7 @@ TEST(LocalMapper, LocalBundleAdjustmentWindowKeepsTheBestCovisibles) {
   EXPECT_EQ(all.local_keyframes, free_count(covisibles));
 
   const LocalBundleAdjustmentReport capped =
-      run_local_bundle_adjustment(*run.map, newest, {}, /*max_covisibles=*/3);
+      run_local_bundle_adjustment(*run.map, newest, {}, {.max_covisibles = 3});
   EXPECT_EQ(capped.local_keyframes, free_count(newest->best_covisibles(3)));
   // The covisible keyframes left out still constrain the window's points, fixed.
   EXPECT_GE(capped.fixed_keyframes, static_cast<int>(covisibles.size()) - 3);

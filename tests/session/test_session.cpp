@@ -53,11 +53,11 @@ FrameReport frame(bool tracked, TrackingMethod method = TrackingMethod::kMotionM
 
 TEST(RunStatistics, CountsLostFramesRelocalisationsAndTheReturnAfterABlackout) {
   RunStatistics stats(DynamicMode::full, FrameRange{2, 3});  // frames 2, 3, 4 black
-  stats.add_frame(0, frame(true), 12.0);
-  stats.add_frame(1, frame(true), 0.0);
-  for (size_t i = 2; i < 6; ++i) stats.add_frame(i, frame(false), 0.0);
-  stats.add_frame(6, frame(true, TrackingMethod::kRelocalisation), 0.0);
-  stats.add_frame(7, frame(true), 0.0);
+  stats.add_frame(0, frame(true), {.wall_ms = 12.0, .cpu_ms = 11.0});
+  stats.add_frame(1, frame(true));
+  for (size_t i = 2; i < 6; ++i) stats.add_frame(i, frame(false));
+  stats.add_frame(6, frame(true, TrackingMethod::kRelocalisation));
+  stats.add_frame(7, frame(true));
   EXPECT_EQ(stats.processed(), 8u);
   EXPECT_EQ(stats.lost(), 4u);
   EXPECT_EQ(stats.relocalisations(), 1u);
@@ -73,28 +73,28 @@ TEST(RunStatistics, CountsLostFramesRelocalisationsAndTheReturnAfterABlackout) {
 TEST(RunStatistics, FindsTheLongestLostStretchAfterTheMapStarted) {
   RunStatistics stats(DynamicMode::full, std::nullopt);
   FrameReport before_map;  // not initialised: not a lost stretch
-  stats.add_frame(0, before_map, 0.0);
-  stats.add_frame(1, frame(true, TrackingMethod::kInitialization), 0.0);
-  stats.add_frame(2, frame(false), 0.0);
-  stats.add_frame(3, frame(false), 0.0);
-  stats.add_frame(4, frame(true), 0.0);
+  stats.add_frame(0, before_map);
+  stats.add_frame(1, frame(true, TrackingMethod::kInitialization));
+  stats.add_frame(2, frame(false));
+  stats.add_frame(3, frame(false));
+  stats.add_frame(4, frame(true));
   EXPECT_EQ(stats.lost_stretches(), 1u);
   ASSERT_TRUE(stats.longest_lost_stretch());
   EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 2u);
   EXPECT_EQ(stats.longest_lost_stretch()->frames, 2u);
   EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::tracked_again);
-  for (size_t i = 5; i < 8; ++i) stats.add_frame(i, frame(false), 0.0);
+  for (size_t i = 5; i < 8; ++i) stats.add_frame(i, frame(false));
   EXPECT_EQ(stats.lost_stretches(), 2u);
   EXPECT_EQ(stats.longest_lost_stretch()->first_frame, 5u);
   EXPECT_EQ(stats.longest_lost_stretch()->last_frame, 7u);
   EXPECT_EQ(stats.longest_lost_stretch()->frames, 3u);
   EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::still_lost);
-  stats.add_frame(8, before_map, 0.0);  // a monocular map started again
+  stats.add_frame(8, before_map);  // a monocular map started again
   EXPECT_EQ(stats.longest_lost_stretch()->end, RunStatistics::LostStretch::End::map_restarted);
   EXPECT_EQ(stats.lost_stretches(), 2u);
 
   RunStatistics never_lost(DynamicMode::full, std::nullopt);
-  never_lost.add_frame(0, frame(true, TrackingMethod::kInitialization), 0.0);
+  never_lost.add_frame(0, frame(true, TrackingMethod::kInitialization));
   EXPECT_EQ(never_lost.lost_stretches(), 0u);
   EXPECT_FALSE(never_lost.longest_lost_stretch());
 }
@@ -104,12 +104,12 @@ TEST(RunStatistics, FindsTheLongestLostStretchAfterTheMapStarted) {
 TEST(RunStatistics, FramesPlacedByTheMapStartCountAsPosed) {
   RunStatistics stats(DynamicMode::full, std::nullopt);
   FrameReport before_map;
-  for (size_t i = 0; i < 3; ++i) stats.add_frame(i, before_map, 0.0);
+  for (size_t i = 0; i < 3; ++i) stats.add_frame(i, before_map);
   EXPECT_EQ(stats.lost(), 3u);
   FrameReport start = frame(true, TrackingMethod::kInitialization);
   start.tracking.earlier_frames = {{1.0, Pose::Identity()}, {2.0, Pose::Identity()}};
-  stats.add_frame(3, start, 0.0);
-  stats.add_frame(4, frame(true), 0.0);
+  stats.add_frame(3, start);
+  stats.add_frame(4, frame(true));
   EXPECT_EQ(stats.processed(), 5u);
   EXPECT_EQ(stats.lost(), 1u);
   EXPECT_EQ(stats.placed_before_initialisation(), 2u);
@@ -119,7 +119,7 @@ TEST(RunStatistics, FramesPlacedByTheMapStartCountAsPosed) {
   // A restart moves every pose of the map it drops, the placed ones too, back to "without pose".
   FrameReport restart = frame(false);
   restart.tracking.restart_due = true;
-  stats.add_frame(5, restart, 0.0);
+  stats.add_frame(5, restart);
   EXPECT_EQ(stats.lost(), 6u);
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -32,6 +33,16 @@ struct KeyFrameData {
   std::vector<float> depth;             // per keypoint, <= 0: none
 };
 
+// What tracking measured when it made a keyframe: its pose relative to the keyframe made before
+// it, as the map held that one at the time, and the information of its pose-only optimisation in
+// the left update [ω; v] of T_camera_world (optimize/pose_optimizer.h). Bundle adjustment keeps
+// it as a relative-pose factor.
+struct TrackedMotion {
+  std::uint64_t previous_keyframe_id = 0;
+  Pose T_camera_previous = Pose::Identity();
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+};
+
 // A frame kept in the map. Owned by Map; everything it refers to (its map points, covisible
 // keyframes, spanning-tree parent and children) is held by weak_ptr, so the Map stays the only
 // owner. Pose, associations and connections are guarded separately because tracking reads
@@ -55,6 +66,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   Pose T_world_camera() const;
   Eigen::Vector3d camera_center() const;
   void set_pose(const Pose& T_camera_world);
+
+  // --- what tracking measured; set once, before the keyframe enters the map (not saved with it)
+  void set_tracked_motion(const TrackedMotion& motion) { tracked_motion_ = motion; }
+  const std::optional<TrackedMotion>& tracked_motion() const { return tracked_motion_; }
 
   // --- immutable features
   int size() const { return static_cast<int>(keypoints_.size()); }
@@ -143,6 +158,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const std::shared_ptr<const CameraModel> camera_;
   const std::shared_ptr<const ScalePyramid> pyramid_;
   const FeatureGrid grid_;
+  std::optional<TrackedMotion> tracked_motion_;
 
   std::mutex bow_mutex_;  // serialises compute_bow; readers use bow_ready_
   std::atomic<bool> bow_ready_{false};

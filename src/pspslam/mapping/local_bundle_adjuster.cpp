@@ -5,6 +5,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
@@ -20,7 +21,23 @@ struct LocalWindow {
   std::vector<int> keypoint_index;  // per observation
 };
 
-LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe, size_t max_covisibles) {
+// Tracking's factor of every window keyframe whose previous keyframe is in the window too.
+void add_tracked_motions(LocalWindow& window,
+                         const std::unordered_map<std::uint64_t, size_t>& keyframe_slot,
+                         double weight) {
+  for (size_t k = 0; k < window.keyframes.size(); ++k) {
+    const std::optional<TrackedMotion>& motion = window.keyframes[k]->tracked_motion();
+    if (!motion) continue;
+    const auto previous = keyframe_slot.find(motion->previous_keyframe_id);
+    if (previous == keyframe_slot.end()) continue;
+    window.problem.relative_poses.push_back(
+        {previous->second, k, motion->T_camera_previous, weight * motion->information});
+  }
+}
+
+LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe,
+                           const LocalWindowOptions& options) {
+  const size_t max_covisibles = options.max_covisibles;
   LocalWindow window;
   std::unordered_map<std::uint64_t, size_t> keyframe_slot;
   const auto add_keyframe = [&](const std::shared_ptr<KeyFrame>& kf, bool fixed) {
@@ -64,6 +81,9 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe, size_t max
       window.keypoint_index.push_back(index);
     }
   }
+  if (options.tracked_motion_weight > 0.0) {
+    add_tracked_motions(window, keyframe_slot, options.tracked_motion_weight);
+  }
   return window;
 }
 
@@ -72,10 +92,12 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe, size_t max
 LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
                                                         const std::shared_ptr<KeyFrame>& keyframe,
                                                         const BaOptions& options,
-                                                        size_t max_covisibles) {
+                                                        const LocalWindowOptions& window_options) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start_ms = thread_cpu_ms();
   LocalBundleAdjustmentReport report;
-  LocalWindow window = collect_window(keyframe, max_covisibles);
+  LocalWindow window = collect_window(keyframe, window_options);
+  report.relative_poses = static_cast<int>(window.problem.relative_poses.size());
   for (const BaKeyframe& kf : window.problem.keyframes) {
     (kf.fixed ? report.fixed_keyframes : report.local_keyframes) += 1;
   }
@@ -109,6 +131,7 @@ LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
     point->update_normal_and_depth(keyframe->pyramid());
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.cpu_ms = thread_cpu_ms() - cpu_start_ms;
   return report;
 }
 

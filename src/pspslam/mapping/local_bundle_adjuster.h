@@ -19,16 +19,27 @@ struct LocalBundleAdjustmentReport {
   int points = 0;
   int observations = 0;
   int outliers_removed = 0;
+  int relative_poses = 0;  // tracking's factors in the problem
   double seconds = 0.0;
+  // CPU time of the calling thread (Ceres runs on it): the cost itself, whatever the load.
+  double cpu_ms = 0.0;
   BaResult result;
 };
 
-// Local keyframes: `keyframe` and its covisible keyframes, the best `max_covisibles` of them
-// (0: all). Local points: all their map points. Fixed: the keyframes that observe local points
-// without being local, and the anchor (id 0).
+struct LocalWindowOptions {
+  // The best this many covisible keyframes of the new one are local (0: all of them).
+  size_t max_covisibles = 0;
+  // Tracking's relative poses between keyframes of the window (KeyFrame::tracked_motion) join the
+  // problem with their information times this weight (0: left out, ORB-SLAM2's BA).
+  double tracked_motion_weight = 0.0;
+};
+
+// Local keyframes: `keyframe` and its covisible keyframes (LocalWindowOptions). Local points: all
+// their map points. Fixed: the keyframes that observe local points without being local, and the
+// anchor (id 0).
 LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
                                                         const std::shared_ptr<KeyFrame>& keyframe,
                                                         const BaOptions& options,
-                                                        size_t max_covisibles = 0);
+                                                        const LocalWindowOptions& window = {});
 
 }  // namespace pspslam

@@ -43,11 +43,14 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
     const std::function<bool()> caller_stop = ba_options.should_stop;
     ba_options.should_stop = [&] { return keyframe_waiting() || (caller_stop && caller_stop()); };
     const LocalBundleAdjustmentReport report = run_local_bundle_adjustment(
-        *map_, keyframe, ba_options, static_cast<size_t>(options_.max_local_keyframes));
+        *map_, keyframe, ba_options,
+        {.max_covisibles = static_cast<size_t>(options_.max_local_keyframes),
+         .tracked_motion_weight = options_.tracked_motion_weight});
     ++stats_.bundle_adjustments;
     stats_.bundle_adjustments_interrupted += report.result.stopped_early;
     stats_.ba_outliers_removed += report.outliers_removed;
     stats_.last_bundle_adjustment_seconds = report.seconds;
+    stats_.last_bundle_adjustment_cpu_ms = report.cpu_ms;
   }
   if (!keyframe_waiting() && options_.cull_keyframes) {
     const auto forget = [this](std::uint64_t id) {

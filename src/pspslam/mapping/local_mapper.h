@@ -27,6 +27,7 @@ struct LocalMappingStats {
   std::uint64_t bundle_adjustments_interrupted = 0;
   std::uint64_t ba_outliers_removed = 0;
   double last_bundle_adjustment_seconds = 0.0;
+  double last_bundle_adjustment_cpu_ms = 0.0;
   double last_keyframe_seconds = 0.0;
 };
 

@@ -1,6 +1,7 @@
 #include "pspslam/optimize/local_bundle_adjustment.h"
 
 #include <ceres/iteration_callback.h>
+#include <ceres/loss_function.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -12,6 +13,7 @@
 
 #include "pspslam/core/error.h"
 #include "pspslam/optimize/pose_manifold.h"
+#include "pspslam/optimize/relative_pose_error.h"
 #include "pspslam/optimize/reprojection_error.h"
 
 namespace pspslam {
@@ -32,6 +34,14 @@ void check_indices(const BaProblem& problem) {
                   std::to_string(problem.keyframes.size()) + " / point " +
                   std::to_string(observation.point) + " of " +
                   std::to_string(problem.points.size()));
+    }
+  }
+  for (size_t i = 0; i < problem.relative_poses.size(); ++i) {
+    const BaRelativePose& factor = problem.relative_poses[i];
+    if (factor.from >= problem.keyframes.size() || factor.to >= problem.keyframes.size()) {
+      throw Error("solve_bundle_adjustment: relative pose " + std::to_string(i) +
+                  " joins keyframes " + std::to_string(factor.from) + " and " +
+                  std::to_string(factor.to) + " of " + std::to_string(problem.keyframes.size()));
     }
   }
 }
@@ -79,7 +89,8 @@ class BaStage {
             const std::vector<uint8_t>& use, bool robust, int max_iterations, double max_seconds,
             StopCallback& stop_callback) {
     ceres::Problem::Options problem_options;
-    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // manifold_ is ours
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;       // manifold_ is ours
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // and the loss
     ceres::Problem ceres_problem(problem_options);
 
     const double huber_mono = robust ? options_.huber_delta_mono : 0.0;
@@ -110,6 +121,8 @@ class BaStage {
       pose_added[observation.keyframe] = 1;
       point_added[observation.point] = 1;
     }
+
+    add_relative_poses(ceres_problem, poses, pose_added);
 
     // Schur elimination: points first (group 0), then the cameras (group 1).
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
@@ -150,10 +163,23 @@ class BaStage {
   }
 
  private:
+  // Tracking's factors between keyframes already in the problem (the others have no pose block).
+  void add_relative_poses(ceres::Problem& ceres_problem, std::vector<PoseParameters>& poses,
+                          const std::vector<uint8_t>& pose_added) {
+    for (const BaRelativePose& factor : problem_.relative_poses) {
+      if (!pose_added[factor.from] || !pose_added[factor.to]) continue;
+      if (problem_.keyframes[factor.from].fixed && problem_.keyframes[factor.to].fixed) continue;
+      auto cost = std::make_unique<RelativePoseCost>(factor.T_to_from, factor.information);
+      ceres_problem.AddResidualBlock(cost.release(), &relative_pose_loss_,
+                                     poses[factor.from].data(), poses[factor.to].data());
+    }
+  }
+
   const BaProblem& problem_;
   StereoProjection model_;
   const BaOptions& options_;
   PoseManifold manifold_;
+  ceres::HuberLoss relative_pose_loss_{options_.huber_delta_relative_pose};
 };
 
 }  // namespace

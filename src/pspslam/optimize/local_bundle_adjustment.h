@@ -23,6 +23,7 @@
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/core/types.h"
 #include "pspslam/optimize/depth_noise_model.h"
+#include "pspslam/optimize/pose_optimizer.h"
 
 namespace pspslam {
 
@@ -45,10 +46,20 @@ struct BaObservation {
   double information = 1.0;  // 1 / σ² of the keypoint's pyramid level
 };
 
+// What tracking measured between two keyframes: b was tracked at T_b_a from a (a as the map
+// held it then), with `information` in b's left update (optimize/pose_optimizer.h).
+struct BaRelativePose {
+  size_t from = 0;  // a: index into BaProblem::keyframes
+  size_t to = 0;    // b
+  Pose T_to_from = Pose::Identity();
+  PoseInformation information = PoseInformation::Identity();
+};
+
 struct BaProblem {
   std::vector<BaKeyframe> keyframes;
   std::vector<BaPoint> points;
   std::vector<BaObservation> observations;
+  std::vector<BaRelativePose> relative_poses;  // optional: tracking's factors
 };
 
 struct BaOptions {
@@ -61,6 +72,9 @@ struct BaOptions {
   double huber_delta_stereo = std::sqrt(7.815);
   double chi2_mono = 5.991;
   double chi2_stereo = 7.815;
+  // Relative-pose factors keep a Huber kernel in both stages, at the 95% χ² of 6 dof: a tracked
+  // pose that followed a moving crowd must not hold its keyframe.
+  double huber_delta_relative_pose = std::sqrt(12.592);
   // Weight of the depth row. Much looser than in pose-only optimisation (σ_d ≈ 1.4 px, about the
   // u_r row's weight but without its pixel error): BA also moves the points, and on real depth a
   // tight depth row there pulls the map off (docs/decisions/depth-weighting.md).
@@ -86,7 +100,9 @@ struct BaResult {
 };
 
 // Optimises the non-fixed keyframe poses and all points that have observations, in place.
-// Throws pspslam::Error when an observation indexes outside the keyframe/point vectors.
+// Relative-pose factors join the cost when both their keyframes are in it (have observations)
+// and at least one is free; they do not count in BaResult's costs.
+// Throws pspslam::Error when an observation or a factor indexes outside the vectors.
 BaResult solve_bundle_adjustment(BaProblem& problem, const PinholeCamera& camera, double bf,
                                  const BaOptions& options = {});
 

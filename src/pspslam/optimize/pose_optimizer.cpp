@@ -253,4 +253,35 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
   return result;
 }
 
+PoseInformation pose_information(const PinholeCamera& camera, double bf,
+                                 const DepthNoiseModel& depth_noise, const Pose& T_camera_world,
+                                 const std::vector<PoseObservation>& observations,
+                                 const PosePrior* prior) {
+  PoseOptimizerOptions options;
+  options.depth_noise = depth_noise;
+  const StereoProjection model = StereoProjection::from(camera, bf, depth_noise);
+  PoseInformation information = PoseInformation::Zero();
+  std::vector<PreparedObservation> prepared =
+      prepare(observations, std::vector<uint8_t>(observations.size(), 1), T_camera_world);
+  for (PreparedObservation& observation : prepared) {
+    if (observation.point_base.z() <= 0.0) continue;
+    // One observation at a time, so that one behind the camera does not void the rest.
+    const FrameReprojectionCost cost(model, {observation}, /*robust=*/false, options);
+    const std::array<double, 6> delta{};
+    const double* parameters[] = {delta.data()};
+    std::array<double, 3> residuals{};
+    Eigen::Matrix<double, 3, 6, Eigen::RowMajor> jacobian;
+    jacobian.setZero();
+    double* jacobians[] = {jacobian.data()};
+    if (!cost.Evaluate(parameters, residuals.data(), jacobians)) continue;
+    const int rows = cost.num_residuals();
+    information.noalias() += jacobian.topRows(rows).transpose() * jacobian.topRows(rows);
+  }
+  if (prior != nullptr) {
+    information.diagonal().head<3>().array() += 1.0 / std::pow(prior->sigma_rotation, 2);
+    information.diagonal().tail<3>().array() += 1.0 / std::pow(prior->sigma_translation, 2);
+  }
+  return information;
+}
+
 }  // namespace pspslam

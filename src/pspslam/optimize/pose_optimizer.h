@@ -23,6 +23,9 @@
 
 namespace pspslam {
 
+// Information of a pose in the left update [ω; v] (rotation rad, translation m).
+using PoseInformation = Eigen::Matrix<double, 6, 6>;
+
 struct PoseObservation {
   Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // undistorted keypoint
@@ -80,5 +83,14 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
                                      const std::vector<PoseObservation>& observations,
                                      const PoseOptimizerOptions& options = {},
                                      const PosePrior* prior = nullptr);
+
+// 6×6 information (Gauss-Newton JᵀJ) of a pose estimated from `observations` (the inliers) under
+// the same whitened residuals as optimize_pose, plus the prior's when given. It is expressed in
+// the optimiser's left update δ = [ω; v] of T_camera_world: the inverse is the covariance of the
+// pose as tracking knows it. Observations behind the camera add nothing.
+PoseInformation pose_information(const PinholeCamera& camera, double bf,
+                                 const DepthNoiseModel& depth_noise, const Pose& T_camera_world,
+                                 const std::vector<PoseObservation>& observations,
+                                 const PosePrior* prior = nullptr);
 
 }  // namespace pspslam

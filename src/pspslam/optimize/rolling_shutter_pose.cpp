@@ -42,6 +42,14 @@ bool accumulate(const StereoProjection& model, const PoseObservation& observatio
   return true;
 }
 
+// The pose block of H with the rate eliminated: H_pp − H_pr H_rr⁻¹ H_rp (H_rr holds the prior,
+// so it is invertible).
+PoseInformation marginal_pose_information(const Matrix9& H) {
+  const Eigen::Matrix3d rate_block = H.bottomRightCorner<3, 3>();
+  const Eigen::Matrix<double, 6, 3> coupling = H.topRightCorner<6, 3>();
+  return H.topLeftCorner<6, 6>() - coupling * rate_block.ldlt().solve(coupling.transpose());
+}
+
 }  // namespace
 
 RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, double bf,
@@ -58,6 +66,7 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
   const double prior_weight = 1.0 / (sigma_rate * sigma_rate);
   Pose pose = initial_T_camera_world;
   Eigen::Vector3d rho = Eigen::Vector3d::Zero();
+  PoseInformation marginal = PoseInformation::Zero();
   for (int iteration = 0; iteration < iterations; ++iteration) {
     Matrix9 H = Matrix9::Zero();
     Vector9 g = Vector9::Zero();
@@ -74,6 +83,7 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
     g.tail<3>() += prior_weight * rho;
     const Eigen::LDLT<Matrix9> solver(H);
     if (solver.info() != Eigen::Success) return {initial_T_camera_world, Eigen::Vector3d::Zero()};
+    marginal = marginal_pose_information(H);
     // r = sqrt(info) (measured - projection): the Gauss-Newton step solves H delta = -J^T r.
     const Vector9 delta = solver.solve(-g);
     if (!delta.allFinite()) return {initial_T_camera_world, Eigen::Vector3d::Zero()};
@@ -85,7 +95,7 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
     rho += delta.tail<3>();
     if (delta.norm() < 1e-10) break;
   }
-  return {pose, rho};
+  return {pose, rho, marginal};
 }
 
 }  // namespace pspslam

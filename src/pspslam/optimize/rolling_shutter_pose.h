@@ -26,6 +26,10 @@ namespace pspslam {
 struct RollingShutterPose {
   Pose T_camera_world = Pose::Identity();
   Eigen::Vector3d rate_correction = Eigen::Vector3d::Zero();  // rho, rad/s, camera frame
+  // The pose's information with rho marginalised out (Schur complement of the last iteration's
+  // normal equations): what the image says about the pose once the rate is free too. Zero when
+  // the refinement gave up.
+  PoseInformation pose_information = PoseInformation::Zero();
 };
 
 // Gauss-Newton on the pose (6) and rho (3) over `observations` (inliers of the pose-only

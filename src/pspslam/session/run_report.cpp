@@ -21,6 +21,13 @@
 namespace pspslam {
 namespace {
 
+// A weight as the user typed it: 0.1, not 0.100000.
+std::string format_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
 double median(std::vector<double> values) { return upper_median(values); }
 
 void print_loop_stats(const MappingStats& mapping, bool monocular, std::ostream& out) {
@@ -195,10 +202,13 @@ void print_frames_and_map(const RunReportInput& input, std::ostream& out) {
                 median(stats.tracking_ms), median(stats.tracking_cpu_ms), mapping.keyframes_in_map,
                 mapping.map_points, mapping.max_queued_keyframes, mapping.local_ba_ms_total);
   out << line;
-  const std::string window =
+  std::string window =
       system.local_ba_keyframes > 0
           ? "the best " + std::to_string(system.local_ba_keyframes) + " covisible keyframes"
           : "every covisible keyframe";
+  if (system.ba_tracking_factors > 0.0)
+    window +=
+        ", with tracking's factors (weight " + format_number(system.ba_tracking_factors) + ")";
   std::snprintf(line, sizeof(line),
                 "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
                 "%zu fused, %zu culled, %zu BA outlier observations removed; %zu local BAs cut "
@@ -395,6 +405,28 @@ nlohmann::ordered_json lost_stretches_json(const RunStatistics& stats) {
   return {{"count", stats.lost_stretches()}, {"longest", longest_lost}};
 }
 
+// Whether local BA's cost grows with the map: its median CPU time over the first and the last
+// sixth of the frames processed (a 3000-frame run: frames 0-500 and 2500-3000), and their ratio.
+// CPU time, not wall time: a machine busier at the end than at the start must not look like
+// growth.
+void add_local_ba_growth(const RunStatistics& stats, nlohmann::ordered_json& json) {
+  const size_t sixth = stats.processed() / 6;
+  std::vector<double> first;
+  std::vector<double> last;
+  for (size_t i = 0; i < stats.local_mapping_ms.size(); ++i) {
+    const double cpu_ms = stats.local_mapping_cpu_ms[i];
+    if (stats.local_mapping_at[i] <= sixth) first.push_back(cpu_ms);
+    if (stats.local_mapping_at[i] > stats.processed() - sixth) last.push_back(cpu_ms);
+  }
+  if (first.empty() || last.empty()) return;
+  const double first_median = summarize(first).median;
+  const double last_median = summarize(last).median;
+  json["local_mapping_cpu"] = to_json(summarize(stats.local_mapping_cpu_ms));
+  json["local_mapping_cpu_first_sixth"] = to_json(summarize(first));
+  json["local_mapping_cpu_last_sixth"] = to_json(summarize(last));
+  json["local_mapping_cpu_growth"] = first_median > 0.0 ? last_median / first_median : 0.0;
+}
+
 nlohmann::ordered_json timing_json(const RunStatistics& stats, const ModuleTimings& t) {
   nlohmann::ordered_json json = {
       {"extraction", to_json(t.extraction)},       {"semantic", to_json(t.semantic)},
@@ -403,6 +435,7 @@ nlohmann::ordered_json timing_json(const RunStatistics& stats, const ModuleTimin
       {"tracking", to_json(t.tracking)},           {"local_mapping", to_json(t.mapping)}};
   if (!stats.observer_cpu_ms.empty())
     json["viewer_hooks_cpu"] = to_json(summarize(stats.observer_cpu_ms));
+  add_local_ba_growth(stats, json);
   return json;
 }
 
@@ -415,7 +448,8 @@ void add_map_json(const RunReportInput& input, nlohmann::ordered_json& json) {
                         {"opencv_threads", cv::getNumThreads()},
                         {"blas_threads", blas_threads()},
                         {"segment_every", system.dynamic.segment_every},
-                        {"local_ba_keyframes", system.local_ba_keyframes}};
+                        {"local_ba_keyframes", system.local_ba_keyframes},
+                        {"ba_tracking_factors", system.ba_tracking_factors}};
   json["map"] = {{"keyframes", mapping.keyframes_in_map},
                  {"map_points", mapping.map_points},
                  {"keyframes_processed", mapping.processed_keyframes},

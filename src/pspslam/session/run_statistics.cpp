@@ -45,11 +45,11 @@ nlohmann::ordered_json to_json(const LatencySummary& latency) {
           {"count", latency.count}};
 }
 
-void RunStatistics::add_frame(size_t index, const FrameReport& report, double local_ba_ms) {
+void RunStatistics::add_frame(size_t index, const FrameReport& report, LocalBaTime local_ba) {
   const TrackResult& result = report.tracking;
   count_pose(index, result);
   follow_lost_stretch(index, result);
-  add_timings(report, local_ba_ms);
+  add_timings(report, local_ba);
   const DynamicReport& dyn = report.dynamic;
   add_live_masks(dyn);
   if (result.pose_held) ++frames_pose_held;
@@ -116,8 +116,12 @@ void RunStatistics::follow_lost_stretch(size_t index, const TrackResult& result)
 }
 
 // Per-module milliseconds and the ages of the masks.
-void RunStatistics::add_timings(const FrameReport& report, double local_ba_ms) {
-  if (local_ba_ms > 0.0) local_mapping_ms.push_back(local_ba_ms);
+void RunStatistics::add_timings(const FrameReport& report, LocalBaTime local_ba) {
+  if (local_ba.wall_ms > 0.0) {
+    local_mapping_ms.push_back(local_ba.wall_ms);
+    local_mapping_cpu_ms.push_back(local_ba.cpu_ms);
+    local_mapping_at.push_back(processed_);
+  }
   extraction_ms.push_back(report.extraction_ms);
   tracking_ms.push_back(report.tracking_ms);
   tracking_cpu_ms.push_back(report.tracking_cpu_ms);

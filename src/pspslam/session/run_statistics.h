@@ -34,6 +34,12 @@ struct LatencySummary {
 LatencySummary summarize_latency(std::vector<double> values);
 nlohmann::ordered_json to_json(const LatencySummary& latency);
 
+// Local BA finished since the frame before: wall and CPU milliseconds (0: none).
+struct LocalBaTime {
+  double wall_ms = 0.0;
+  double cpu_ms = 0.0;
+};
+
 // Accumulates what each frame of a run reports: per-module times, dynamic-feature totals, lost
 // frames, relocalisations and (with a blackout) when poses came back. Read by run_report.h.
 class RunStatistics {
@@ -42,9 +48,8 @@ class RunStatistics {
   RunStatistics(DynamicMode mode, std::optional<FrameRange> blackout, int stale_mask_frames = 2)
       : mode_(mode), blackout_(blackout), stale_mask_frames_(stale_mask_frames) {}
 
-  // Frame `index` of the sequence; `local_ba_ms` = local BA time finished since the frame
-  // before (0: none).
-  void add_frame(size_t index, const FrameReport& report, double local_ba_ms);
+  // Frame `index` of the sequence, with the local BA time finished since the frame before.
+  void add_frame(size_t index, const FrameReport& report, LocalBaTime local_ba = {});
   // Frames the real-time feed skipped since the last frame.
   void add_dropped(size_t frames) { realtime_dropped_ += frames; }
 
@@ -82,7 +87,9 @@ class RunStatistics {
   std::vector<double> geometry_ms;
   std::vector<double> geometry_search_ms;
   std::vector<double> flow_ms;
-  std::vector<double> local_mapping_ms;  // one entry per local BA
+  std::vector<double> local_mapping_ms;      // one entry per local BA
+  std::vector<double> local_mapping_cpu_ms;  // its CPU time
+  std::vector<size_t> local_mapping_at;      // per local BA: frames processed before it ended
   std::vector<double> mask_age_frames;
   std::vector<double> mask_latency_ms;
   // Thread CPU of the run loop in a RunObserver's hooks per frame (`run --viewer`; a held loop
@@ -113,7 +120,7 @@ class RunStatistics {
  private:
   void count_pose(size_t index, const TrackResult& result);
   void follow_lost_stretch(size_t index, const TrackResult& result);
-  void add_timings(const FrameReport& report, double local_ba_ms);
+  void add_timings(const FrameReport& report, LocalBaTime local_ba);
   void add_live_masks(const DynamicReport& dynamic);
 
   DynamicMode mode_;

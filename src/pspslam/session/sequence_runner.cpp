@@ -160,7 +160,7 @@ RunOutcome SequenceRunner::run() {
 
 void SequenceRunner::feed_frames(ProgressBar& progress, StartWatch& start_watch) {
   const bool realtime = options_.system.dynamic.realtime;
-  double ba_ms_before = 0.0;
+  MappingStats mapping_before;
   // Deterministic runs load one frame ahead and announce it to the semantic thread, so the
   // network segments frame i+1 while frame i is tracked.
   std::optional<InputFrame> next;
@@ -177,7 +177,7 @@ void SequenceRunner::feed_frames(ProgressBar& progress, StartWatch& start_watch)
     check_frame_size(frame);
     const double observer_cpu = ask_observer_detail();
     const FrameReport report = system_->process(frame);
-    const MappingStats mapping = record_frame(frame, report, start_watch, ba_ms_before);
+    const MappingStats mapping = record_frame(frame, report, start_watch, mapping_before);
     progress.update(statistics_.processed(), statistics_.realtime_dropped());
     if (observer_) {
       const double cpu_before = thread_cpu_ms();
@@ -198,7 +198,7 @@ double SequenceRunner::ask_observer_detail() {
 }
 
 MappingStats SequenceRunner::record_frame(const InputFrame& frame, const FrameReport& report,
-                                          StartWatch& start_watch, double& ba_ms_before) {
+                                          StartWatch& start_watch, MappingStats& mapping_before) {
   std::optional<double> arrival_to_pose_ms;
   if (frame.arrival) {
     arrival_to_pose_ms =
@@ -218,16 +218,16 @@ MappingStats SequenceRunner::record_frame(const InputFrame& frame, const FrameRe
   log_.write_earlier(result.earlier_frames);
   if (result.T_world_camera) estimate_.push_back({frame.timestamp, *result.T_world_camera});
   const MappingStats mapping = system_->mapping_stats();
-  const double local_ba_ms = mapping.local_ba_ms_total - ba_ms_before;
-  log_.write(frame.index, frame.timestamp, report, local_ba_ms, mapping, arrival_to_pose_ms);
+  const LocalBaTime local_ba{mapping.local_ba_ms_total - mapping_before.local_ba_ms_total,
+                             mapping.local_ba_cpu_ms_total - mapping_before.local_ba_cpu_ms_total};
+  log_.write(frame.index, frame.timestamp, report, local_ba.wall_ms, mapping, arrival_to_pose_ms);
   if (result.restart_due) {
     // The new map has its own world frame and scale: the old poses would corrupt the file.
     log_.forget_poses();
     estimate_.clear();
   }
-  statistics_.add_frame(frame.index, report,
-                        mapping.local_ba_ms_total > ba_ms_before ? local_ba_ms : 0.0);
-  ba_ms_before = mapping.local_ba_ms_total;
+  statistics_.add_frame(frame.index, report, local_ba);
+  mapping_before = mapping;
   return mapping;
 }
 

@@ -58,7 +58,7 @@ class SequenceRunner {
   double ask_observer_detail();
   // The frame's pose, log line, images and statistics; returns the mapping totals after it.
   MappingStats record_frame(const InputFrame& frame, const FrameReport& report,
-                            StartWatch& start_watch, double& ba_ms_before);
+                            StartWatch& start_watch, MappingStats& mapping_before);
   void save_map();  // --save-map
   RunOutcome outcome(const StartWatch& start_watch);
   void write_images(const InputFrame& frame, const FrameReport& report);

@@ -125,6 +125,7 @@ class System::MappingConnection final : public KeyFrameSink {
     stats.max_queued_keyframes = max_queue_;
     stats.processed_keyframes = processed_;
     stats.local_ba_ms_total = ba_ms_total_;
+    stats.local_ba_cpu_ms_total = ba_cpu_ms_total_;
     stats.keyframes_culled = last_.keyframes_culled;
     stats.points_culled = last_.points_culled;
     stats.points_triangulated = last_.points_triangulated;
@@ -141,8 +142,10 @@ class System::MappingConnection final : public KeyFrameSink {
     const LocalMappingStats stats = mapping_->stats();
     std::lock_guard lock(mutex_);
     if (stats.bundle_adjustments > bundle_adjustments_seen_) {
-      ba_ms_total_ += 1000.0 * stats.last_bundle_adjustment_seconds *
-                      static_cast<double>(stats.bundle_adjustments - bundle_adjustments_seen_);
+      const auto new_ones =
+          static_cast<double>(stats.bundle_adjustments - bundle_adjustments_seen_);
+      ba_ms_total_ += 1000.0 * stats.last_bundle_adjustment_seconds * new_ones;
+      ba_cpu_ms_total_ += stats.last_bundle_adjustment_cpu_ms * new_ones;
       bundle_adjustments_seen_ = stats.bundle_adjustments;
     }
     processed_ = stats.keyframes_processed;
@@ -156,6 +159,7 @@ class System::MappingConnection final : public KeyFrameSink {
   size_t processed_ = 0;
   std::uint64_t bundle_adjustments_seen_ = 0;
   double ba_ms_total_ = 0.0;
+  double ba_cpu_ms_total_ = 0.0;
   LocalMappingStats last_;
 };
 
@@ -166,6 +170,7 @@ LocalMappingOptions local_mapping_options(const SystemConfig& config, const Syst
   LocalMappingOptions mapping;
   mapping.close_depth = config.camera.depth_threshold;
   mapping.max_local_keyframes = options.local_ba_keyframes;
+  mapping.tracked_motion_weight = options.ba_tracking_factors;
   // The BA's wall-clock budget keeps a live system responsive; a synchronous run bounds BA by
   // its iteration counts only, so its result does not depend on the machine's load.
   if (options.back_end_wait != BackEndWait::none)

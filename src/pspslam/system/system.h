@@ -27,7 +27,8 @@ struct MappingStats {
   size_t queued_keyframes = 0;      // waiting for local mapping now
   size_t max_queued_keyframes = 0;  // over the run: growth means mapping cannot keep up
   size_t processed_keyframes = 0;
-  double local_ba_ms_total = 0.0;  // wall time spent in local BA so far
+  double local_ba_ms_total = 0.0;      // wall time spent in local BA so far
+  double local_ba_cpu_ms_total = 0.0;  // its CPU time: the cost, whatever the machine's load
   size_t keyframes_culled = 0;
   size_t points_culled = 0;
   size_t points_triangulated = 0;

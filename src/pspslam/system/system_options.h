@@ -42,6 +42,9 @@ struct SystemOptions {
   BackEndWait back_end_wait = BackEndWait::none;
   // Local BA window size (LocalMappingOptions::max_local_keyframes; 0: every covisible one).
   int local_ba_keyframes = 0;
+  // Weight of tracking's relative poses between keyframes in local BA
+  // (LocalMappingOptions::tracked_motion_weight; 0: none).
+  double ba_tracking_factors = 0.0;
   // Nice increment of the semantic, local mapping and loop closing threads (and of the global
   // BA threads loop closing starts). A live run (--realtime, a camera) sets it so that the
   // caller thread, which must track each frame before the next one arrives, gets a core when

@@ -42,10 +42,10 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
   return optimized;
 }
 
-Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
-                                           double sigma_rate, FramePoseBuffers& buffers) {
+RollingShutterPose refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
+                                              double sigma_rate, FramePoseBuffers& buffers) {
   const CameraModel& camera = frame.camera();
-  if (camera.rolling_shutter_readout_s == 0.0) return Eigen::Vector3d::Zero();
+  if (camera.rolling_shutter_readout_s == 0.0) return {frame.T_camera_world()};
   gather_observations(frame, /*inliers_only=*/true, buffers);
   buffers.row_times.clear();
   for (const PoseObservation& observation : buffers.observations) {
@@ -57,7 +57,14 @@ Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOpti
       buffers.row_times, sigma_rate);
   frame.set_pose(orthonormalized(refined.T_camera_world));
   frame.correct_rotation_rate(refined.rate_correction);
-  return refined.rate_correction;
+  return refined;
+}
+
+PoseInformation frame_pose_information(const Frame& frame, const PoseOptimizerOptions& options,
+                                       FramePoseBuffers& buffers, const PosePrior* prior) {
+  gather_observations(frame, /*inliers_only=*/true, buffers);
+  return pose_information(frame.camera().pinhole, frame.camera().bf, options.depth_noise,
+                          frame.T_camera_world(), buffers.observations, prior);
 }
 
 }  // namespace pspslam

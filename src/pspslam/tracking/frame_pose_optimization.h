@@ -4,6 +4,7 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/optimize/pose_optimizer.h"
+#include "pspslam/optimize/rolling_shutter_pose.h"
 
 namespace pspslam {
 
@@ -33,8 +34,14 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
 // Rolling shutter (CameraModel::rolling_shutter_readout_s != 0): the pose and the rotation rate of
 // `frame` refined together on its inlier matches (optimize/rolling_shutter_pose.h, prior
 // `sigma_rate` rad/s), the pose set and the keypoints moved by the rate correction, which is
-// returned (rad/s, camera frame; zero for a global shutter, which changes nothing).
-Eigen::Vector3d refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
-                                           double sigma_rate, FramePoseBuffers& buffers);
+// returned (rad/s, camera frame) with the pose's information, the rate marginalised. A global
+// shutter changes nothing and gets zeros.
+RollingShutterPose refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
+                                              double sigma_rate, FramePoseBuffers& buffers);
+
+// The information of the frame's pose on its inlier matches (optimize/pose_optimizer.h
+// pose_information), with `prior`'s when given.
+PoseInformation frame_pose_information(const Frame& frame, const PoseOptimizerOptions& options,
+                                       FramePoseBuffers& buffers, const PosePrior* prior);
 
 }  // namespace pspslam

@@ -11,8 +11,8 @@
 
 namespace pspslam {
 
-std::shared_ptr<KeyFrame> create_keyframe(Frame& frame, Map& map, bool initial,
-                                          int min_new_points) {
+std::shared_ptr<KeyFrame> create_keyframe(Frame& frame, Map& map, bool initial, int min_new_points,
+                                          const std::optional<TrackedMotion>& motion) {
   // Drop outlier associations before copying them into the keyframe.
   for (int i = 0; i < frame.size(); ++i) {
     if (frame.outlier[i]) {
@@ -21,6 +21,7 @@ std::shared_ptr<KeyFrame> create_keyframe(Frame& frame, Map& map, bool initial,
     }
   }
   auto keyframe = std::make_shared<KeyFrame>(map.next_keyframe_id(), frame);
+  if (motion) keyframe->set_tracked_motion(*motion);
   map.add_keyframe(keyframe);
 
   // Existing matches become observations of the new keyframe.

@@ -96,9 +96,12 @@ TrackResult Tracker::track(Frame frame) {
       }
     }
     if (ok) ok = track_local_map(frame);
+    rolling_shutter_information_.setZero();
     if (ok) {
-      angular_velocity_ += refine_frame_rotation_rate(frame, options_.pose_optimizer,
-                                                      options_.rotation_rate_sigma, pose_buffers_);
+      const RollingShutterPose refined = refine_frame_rotation_rate(
+          frame, options_.pose_optimizer, options_.rotation_rate_sigma, pose_buffers_);
+      angular_velocity_ += refined.rate_correction;
+      rolling_shutter_information_ = refined.pose_information;
     }
     if (ok) {
       state_ = TrackingState::kOk;
@@ -197,6 +200,7 @@ bool Tracker::initialize(Frame& frame, TrackResult& result) {
                         earlier.T_camera_world, earlier.is_first_keyframe, map_epoch_});
   }
   reference_keyframe_ = keyframes.back();
+  last_keyframe_ = reference_keyframe_;
   last_keyframe_frame_id_ = frame.id();
   local_map_.update(frame);
   if (sink_ != nullptr) {
@@ -213,6 +217,7 @@ void Tracker::restart() {
   motion_prior_.reset();
   last_tracked_pose_.reset();
   reference_keyframe_.reset();
+  last_keyframe_.reset();
   last_keyframe_frame_id_ = 0;
   last_recovery_frame_id_ = 0;
   local_map_ = LocalMap(options_.max_local_keyframes);
@@ -240,6 +245,28 @@ int Tracker::discard_outliers(Frame& frame) {
     }
   }
   return matched_in_map;
+}
+
+std::optional<TrackedMotion> Tracker::tracked_motion(const Frame& frame) {
+  std::shared_ptr<KeyFrame> previous = last_keyframe_.lock();
+  if (!previous || previous->is_bad()) previous = reference_keyframe_;
+  if (!previous || previous->is_bad()) return std::nullopt;
+  const PosePrior* prior = motion_prior_ ? &*motion_prior_ : nullptr;
+  TrackedMotion motion;
+  motion.previous_keyframe_id = previous->id();
+  motion.T_camera_previous = frame.T_camera_world() * previous->T_world_camera();
+  // The rolling-shutter refinement ran last: its information, the rate marginalised, is the
+  // pose's; a global shutter has only the pose-only optimisation's.
+  motion.information =
+      rolling_shutter_information_.isZero()
+          ? frame_pose_information(frame, options_.pose_optimizer, pose_buffers_, prior)
+          : rolling_shutter_information_;
+  if (prior != nullptr && !rolling_shutter_information_.isZero()) {
+    motion.information +=
+        pose_information(frame.camera().pinhole, frame.camera().bf,
+                         options_.pose_optimizer.depth_noise, frame.T_camera_world(), {}, prior);
+  }
+  return motion;
 }
 
 int Tracker::optimize_frame_pose(Frame& frame) {
@@ -416,7 +443,9 @@ void Tracker::maybe_insert_keyframe(Frame& frame, TrackResult& result) {
     sink_->interrupt_bundle_adjustment();
   }
   if (decision == KeyFrameDecision::kInterruptMapper) return;
-  reference_keyframe_ = create_keyframe(frame, map_, /*initial=*/false);
+  const std::optional<TrackedMotion> motion = tracked_motion(frame);
+  reference_keyframe_ = create_keyframe(frame, map_, /*initial=*/false, 100, motion);
+  last_keyframe_ = reference_keyframe_;
   last_keyframe_frame_id_ = frame.id();
   result.keyframe_inserted = true;
   if (sink_ != nullptr) sink_->insert_keyframe(reference_keyframe_);

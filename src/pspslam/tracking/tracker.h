@@ -22,6 +22,7 @@ class KeyFrame;
 class KeyFrameSink;
 class Map;
 class PlaceRecognition;
+struct TrackedMotion;
 
 struct TrackerOptions {
   int min_initial_depth_points = 500;  // keypoints with depth needed to start the map (RGB-D)
@@ -173,6 +174,9 @@ class Tracker {
   // After a motion-model frame's pose is final: the prediction instead when MoverGuard says so.
   void guard_against_movers(Frame& frame, TrackResult& result);
 
+  // The frame's pose relative to the keyframe made last (else the reference keyframe), with the
+  // information tracking has for it: kept by the keyframe made from the frame.
+  std::optional<TrackedMotion> tracked_motion(const Frame& frame);
   // Pose-only optimisation of the frame on its current matches; flags outliers, returns inliers.
   int optimize_frame_pose(Frame& frame);
   // Drops outlier matches; returns how many matches with map observations remain.
@@ -196,7 +200,11 @@ class Tracker {
   MoverGuard mover_guard_;
   std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
   std::shared_ptr<KeyFrame> reference_keyframe_;
+  std::weak_ptr<KeyFrame> last_keyframe_;  // the keyframe this tracker made last
   std::uint64_t last_keyframe_frame_id_ = 0;
+  // The pose information of the frame being tracked from its rolling-shutter refinement (zero for
+  // a global shutter or when the refinement gave up).
+  PoseInformation rolling_shutter_information_ = PoseInformation::Zero();
   std::uint64_t last_recovery_frame_id_ = 0;
   LocalMap local_map_;
   std::unique_ptr<Relocalizer> relocalizer_;  // null without a vocabulary

@@ -117,6 +117,7 @@ struct RunFlags {
   bool due_keyframes = false;
   int local_ba_keyframes = -1;  // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
   double ba_tracking_factors = 0.0;
+  int local_ba_fixed_keyframes = 0;
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
   std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
@@ -162,6 +163,7 @@ RunSettings run_settings(const RunFlags& flags) {
   settings.due_keyframes = flags.due_keyframes;
   if (flags.local_ba_keyframes >= 0) settings.local_ba_keyframes = flags.local_ba_keyframes;
   settings.ba_tracking_factors = flags.ba_tracking_factors;
+  settings.local_ba_fixed_keyframes = flags.local_ba_fixed_keyframes;
   if (flags.background_nice >= 0) settings.background_nice = flags.background_nice;
   if (flags.motion_prior.size() == 2)
     settings.motion_prior = std::pair(flags.motion_prior[0], flags.motion_prior[1]);
@@ -474,6 +476,12 @@ void add_keyframe_options(CLI::App* app, RunFlags& flags) {
                       " with --realtime or --camera, so that local BA keeps up on two cores; 0 "
                       "otherwise)")
       ->check(in_range(0, 1000));
+  app->add_option("--local-ba-fixed-keyframes", flags.local_ba_fixed_keyframes,
+                  "of the keyframes held fixed around the local BA window (those that see its "
+                  "points), keep the ones that see the most of them; 0 = all, as ORB-SLAM2 "
+                  "(bounds local BA where a revisited room has many)")
+      ->check(in_range(0, 1000))
+      ->capture_default_str();
   app->add_option("--ba-tracking-factors", flags.ba_tracking_factors,
                   "WEIGHT: local BA also keeps each keyframe's pose relative to the keyframe "
                   "before it as tracking measured it, weighted by WEIGHT times the information "

@@ -612,6 +612,11 @@ TEST(CliRun, FlagValuesAreCheckedBeforeAnyWork) {
   EXPECT_EQ(r.output,
             "error: pspslam run: --semantic-delay-seed requires --semantic-delay-ms (see 'pspslam "
             "run --help')\n");
+  r = pspslam(run + "--local-ba-fixed-keyframes -3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --local-ba-fixed-keyframes: must be an integer in [0, 1000], got "
+            "'-3' (see 'pspslam run --help')\n");
   r = pspslam(run + "--max-frames -1");
   EXPECT_EQ(r.output,
             "error: pspslam run: --max-frames: must be an integer in [0, 1000000000], got '-1' "

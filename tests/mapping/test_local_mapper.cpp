@@ -148,6 +148,25 @@ TEST(LocalMapper, LocalBundleAdjustmentWindowKeepsTheBestCovisibles) {
   expect_consistent(*run.map);
 }
 
+// A capped border: of the keyframes held fixed around a window of 2, only the 2 that see the most
+// of its points remain, with their observations; the window's own keyframes are unchanged.
+TEST(LocalMapper, LocalBundleAdjustmentBorderKeepsTheKeyframesSeeingMostOfTheWindow) {
+  SyntheticWorld world(900, 0.35, 21);
+  PathRun run = run_path(world, 8);
+  const auto newest = run.map->keyframe(run.map->max_keyframe_id());
+  ASSERT_TRUE(newest);
+  const LocalBundleAdjustmentReport border_all =
+      run_local_bundle_adjustment(*run.map, newest, {}, {.max_covisibles = 2});
+  ASSERT_GT(border_all.fixed_keyframes, 2);
+  const LocalBundleAdjustmentReport border_two = run_local_bundle_adjustment(
+      *run.map, newest, {}, {.max_covisibles = 2, .max_fixed_keyframes = 2});
+  EXPECT_EQ(border_two.local_keyframes, border_all.local_keyframes);
+  EXPECT_EQ(border_two.fixed_keyframes, 2);
+  EXPECT_EQ(border_two.points, border_all.points);
+  EXPECT_LT(border_two.observations, border_all.observations);
+  expect_consistent(*run.map);
+}
+
 TEST(LocalMapper, CullsRedundantKeyframes) {
   SyntheticWorld world(600, 0.0, 22);
   auto map = std::make_shared<Map>();

@@ -1,9 +1,14 @@
 #include "pspslam/mapping/local_bundle_adjuster.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
 
 #include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/map/keyframe.h"
@@ -35,6 +40,26 @@ void add_tracked_motions(LocalWindow& window,
   }
 }
 
+// The border keyframes a capped window keeps: those that see the most of its points (none: no
+// cap, every keyframe that sees one).
+std::optional<std::unordered_set<std::uint64_t>> best_border_keyframes(
+    const LocalWindow& window, const std::unordered_map<std::uint64_t, size_t>& local_slot,
+    size_t max_fixed) {
+  if (max_fixed == 0) return std::nullopt;
+  std::unordered_map<std::uint64_t, int> shared_points;
+  for (const auto& point : window.points) {
+    for (const auto& [keyframe_id, observation] : point->observations()) {
+      if (!local_slot.contains(keyframe_id)) ++shared_points[keyframe_id];
+    }
+  }
+  std::vector<std::pair<int, std::uint64_t>> ranked;
+  for (const auto& [id, count] : shared_points) ranked.emplace_back(-count, id);
+  std::sort(ranked.begin(), ranked.end());  // most shared first; ties by id: deterministic
+  std::unordered_set<std::uint64_t> kept;
+  for (size_t i = 0; i < std::min(max_fixed, ranked.size()); ++i) kept.insert(ranked[i].second);
+  return kept;
+}
+
 LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe,
                            const LocalWindowOptions& options) {
   const size_t max_covisibles = options.max_covisibles;
@@ -63,12 +88,15 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe,
     }
   }
 
+  const std::optional<std::unordered_set<std::uint64_t>> border =
+      best_border_keyframes(window, keyframe_slot, options.max_fixed_keyframes);
   for (size_t p = 0; p < window.points.size(); ++p) {
     for (const auto& [keyframe_id, observation] : window.points[p]->observations()) {
       const auto observer = observation.keyframe.lock();
       if (!observer || observer->is_bad()) continue;
       auto slot = keyframe_slot.find(keyframe_id);
       if (slot == keyframe_slot.end()) {
+        if (border && !border->contains(keyframe_id)) continue;
         add_keyframe(observer, /*fixed=*/true);  // border keyframe: constrains, never moves
         slot = keyframe_slot.find(keyframe_id);
       }

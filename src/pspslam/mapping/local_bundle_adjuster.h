@@ -29,6 +29,9 @@ struct LocalBundleAdjustmentReport {
 struct LocalWindowOptions {
   // The best this many covisible keyframes of the new one are local (0: all of them).
   size_t max_covisibles = 0;
+  // Of the keyframes outside the window that see its points (held fixed), only the ones that see
+  // the most of them (0: all). Bounds the problem where a revisited room has many such keyframes.
+  size_t max_fixed_keyframes = 0;
   // Tracking's relative poses between keyframes of the window (KeyFrame::tracked_motion) join the
   // problem with their information times this weight (0: left out, ORB-SLAM2's BA).
   double tracked_motion_weight = 0.0;

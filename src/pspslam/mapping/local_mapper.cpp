@@ -45,6 +45,7 @@ void LocalMapper::process(const std::shared_ptr<KeyFrame>& keyframe,
     const LocalBundleAdjustmentReport report = run_local_bundle_adjustment(
         *map_, keyframe, ba_options,
         {.max_covisibles = static_cast<size_t>(options_.max_local_keyframes),
+         .max_fixed_keyframes = static_cast<size_t>(options_.max_fixed_keyframes),
          .tracked_motion_weight = options_.tracked_motion_weight});
     ++stats_.bundle_adjustments;
     stats_.bundle_adjustments_interrupted += report.result.stopped_early;

@@ -36,6 +36,8 @@ struct LocalMappingOptions {
   // Local BA window: the new keyframe and at most this many of its best covisible keyframes
   // (0: all of them, as ORB-SLAM2). The rest that see the window's points are held fixed.
   int max_local_keyframes = 0;
+  // Of the keyframes held fixed around it, the ones that see the most of its points (0: all).
+  int max_fixed_keyframes = 0;
   // Weight of tracking's relative poses between keyframes in local BA (0: none; see
   // LocalWindowOptions::tracked_motion_weight).
   double tracked_motion_weight = 0.0;

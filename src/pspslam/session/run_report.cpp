@@ -449,6 +449,7 @@ void add_map_json(const RunReportInput& input, nlohmann::ordered_json& json) {
                         {"blas_threads", blas_threads()},
                         {"segment_every", system.dynamic.segment_every},
                         {"local_ba_keyframes", system.local_ba_keyframes},
+                        {"local_ba_fixed_keyframes", system.local_ba_fixed_keyframes},
                         {"ba_tracking_factors", system.ba_tracking_factors}};
   json["map"] = {{"keyframes", mapping.keyframes_in_map},
                  {"map_points", mapping.map_points},

@@ -96,6 +96,7 @@ SystemOptions system_options(const RunSettings& settings, const SettingNames& na
   system.local_ba_keyframes =
       settings.local_ba_keyframes.value_or(live ? kLiveLocalBaKeyframes : 0);
   system.ba_tracking_factors = settings.ba_tracking_factors;
+  system.local_ba_fixed_keyframes = settings.local_ba_fixed_keyframes;
   set_tracking(settings, system);
   set_place(settings, system);
   system.back_end_wait = settings.realtime ? BackEndWait::none : BackEndWait::whole_back_end;

@@ -38,6 +38,7 @@ struct RunSettings {
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
   std::optional<int> local_ba_keyframes;  // none: kLiveLocalBaKeyframes when live, else 0 (all)
+  int local_ba_fixed_keyframes = 0;       // 0: every keyframe that sees the window's points
   double ba_tracking_factors = 0.0;       // weight of tracking's relative poses in local BA
   std::optional<int> background_nice;     // none: kLiveBackgroundNice when live, else 0
   std::optional<std::pair<double, double>> motion_prior;  // millimetres, degrees

@@ -170,6 +170,7 @@ LocalMappingOptions local_mapping_options(const SystemConfig& config, const Syst
   LocalMappingOptions mapping;
   mapping.close_depth = config.camera.depth_threshold;
   mapping.max_local_keyframes = options.local_ba_keyframes;
+  mapping.max_fixed_keyframes = options.local_ba_fixed_keyframes;
   mapping.tracked_motion_weight = options.ba_tracking_factors;
   // The BA's wall-clock budget keeps a live system responsive; a synchronous run bounds BA by
   // its iteration counts only, so its result does not depend on the machine's load.

@@ -42,6 +42,8 @@ struct SystemOptions {
   BackEndWait back_end_wait = BackEndWait::none;
   // Local BA window size (LocalMappingOptions::max_local_keyframes; 0: every covisible one).
   int local_ba_keyframes = 0;
+  // Of the fixed keyframes around the window, the ones that see most of its points (0: all).
+  int local_ba_fixed_keyframes = 0;
   // Weight of tracking's relative poses between keyframes in local BA
   // (LocalMappingOptions::tracked_motion_weight; 0: none).
   double ba_tracking_factors = 0.0;

@@ -82,13 +82,15 @@ TEST(RelativePoseCost, IsZeroAtTheMeasuredRelativePoseAndWeighsByTheInformation)
   const Pose T_b = make_pose({0.0, 0.2, 0.0}, {0.1, 0.0, 0.0});
   const PoseParameters a = PoseParameters::from_pose(T_a);
   const PoseParameters b = PoseParameters::from_pose(T_b);
-  EXPECT_LT(RelativePoseCost(T_b * T_a.inverse(), Matrix6::Identity()).chi_squared(a, b), 1e-20);
+  EXPECT_LT(
+      residual_at(RelativePoseCost(T_b * T_a.inverse(), Matrix6::Identity()), a, b).squaredNorm(),
+      1e-20);
 
   // 1 cm off along x in b's frame: χ² = 0.01² · information_xx.
   const Pose off = make_pose({0, 0, 0}, {0.01, 0.0, 0.0}) * T_b * T_a.inverse();
   Matrix6 information = Matrix6::Identity();
   information(3, 3) = 1e4;
-  EXPECT_NEAR(RelativePoseCost(off, information).chi_squared(a, b), 1.0, 1e-9);
+  EXPECT_NEAR(residual_at(RelativePoseCost(off, information), a, b).squaredNorm(), 1.0, 1e-9);
 }
 
 // Observations of a pose: random points 1-5 m ahead with depth, 1 px noise.

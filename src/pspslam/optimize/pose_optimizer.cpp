@@ -253,33 +253,40 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
   return result;
 }
 
+PoseInformation prior_information(const PosePrior& prior) {
+  PoseInformation information = PoseInformation::Zero();
+  information.diagonal().head<3>().setConstant(1.0 / (prior.sigma_rotation * prior.sigma_rotation));
+  information.diagonal().tail<3>().setConstant(1.0 /
+                                               (prior.sigma_translation * prior.sigma_translation));
+  return information;
+}
+
 PoseInformation pose_information(const PinholeCamera& camera, double bf,
                                  const DepthNoiseModel& depth_noise, const Pose& T_camera_world,
                                  const std::vector<PoseObservation>& observations,
                                  const PosePrior* prior) {
+  PoseInformation information =
+      prior != nullptr ? prior_information(*prior) : PoseInformation::Zero();
+  // The observations in front of the camera (whitened_residual's own bound): one behind it would
+  // make the cost refuse the whole evaluation.
+  std::vector<uint8_t> in_front(observations.size(), 0);
+  for (size_t i = 0; i < observations.size(); ++i) {
+    in_front[i] = (T_camera_world * observations[i].point_world).z() >= 1e-6;
+  }
   PoseOptimizerOptions options;
   options.depth_noise = depth_noise;
-  const StereoProjection model = StereoProjection::from(camera, bf, depth_noise);
-  PoseInformation information = PoseInformation::Zero();
-  std::vector<PreparedObservation> prepared =
-      prepare(observations, std::vector<uint8_t>(observations.size(), 1), T_camera_world);
-  for (PreparedObservation& observation : prepared) {
-    if (observation.point_base.z() <= 0.0) continue;
-    // One observation at a time, so that one behind the camera does not void the rest.
-    const FrameReprojectionCost cost(model, {observation}, /*robust=*/false, options);
-    const std::array<double, 6> delta{};
-    const double* parameters[] = {delta.data()};
-    std::array<double, 3> residuals{};
-    Eigen::Matrix<double, 3, 6, Eigen::RowMajor> jacobian;
-    jacobian.setZero();
-    double* jacobians[] = {jacobian.data()};
-    if (!cost.Evaluate(parameters, residuals.data(), jacobians)) continue;
-    const int rows = cost.num_residuals();
-    information.noalias() += jacobian.topRows(rows).transpose() * jacobian.topRows(rows);
-  }
-  if (prior != nullptr) {
-    information.diagonal().head<3>().array() += 1.0 / std::pow(prior->sigma_rotation, 2);
-    information.diagonal().tail<3>().array() += 1.0 / std::pow(prior->sigma_translation, 2);
+  const FrameReprojectionCost cost(StereoProjection::from(camera, bf, depth_noise),
+                                   prepare(observations, in_front, T_camera_world),
+                                   /*robust=*/false, options);
+  if (cost.num_residuals() == 0) return information;
+  // The Jacobian at δ = 0 of the optimiser's own residuals: JᵀJ is its Gauss-Newton information.
+  const std::array<double, 6> delta{};
+  const double* parameters[] = {delta.data()};
+  std::vector<double> residuals(cost.num_residuals());
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> jacobian(cost.num_residuals(), 6);
+  double* jacobians[] = {jacobian.data()};
+  if (cost.Evaluate(parameters, residuals.data(), jacobians)) {
+    information.noalias() += jacobian.transpose() * jacobian;
   }
   return information;
 }

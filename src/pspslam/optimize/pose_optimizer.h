@@ -84,6 +84,9 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
                                      const PoseOptimizerOptions& options = {},
                                      const PosePrior* prior = nullptr);
 
+// The information of a prior alone: diag(1/σ_r², 1/σ_r², 1/σ_r², 1/σ_t², 1/σ_t², 1/σ_t²).
+PoseInformation prior_information(const PosePrior& prior);
+
 // 6×6 information (Gauss-Newton JᵀJ) of a pose estimated from `observations` (the inliers) under
 // the same whitened residuals as optimize_pose, plus the prior's when given. It is expressed in
 // the optimiser's left update δ = [ω; v] of T_camera_world: the inverse is the covariance of the

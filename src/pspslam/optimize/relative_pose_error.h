@@ -67,14 +67,6 @@ class RelativePoseCost final : public ceres::SizedCostFunction<6, 7, 7> {
     return true;
   }
 
-  // The factor's χ² at these poses (6 dof).
-  double chi_squared(const PoseParameters& a, const PoseParameters& b) const {
-    const double* parameters[] = {a.data(), b.data()};
-    Eigen::Matrix<double, 6, 1> r;
-    Evaluate(parameters, r.data(), nullptr);
-    return r.squaredNorm();
-  }
-
  private:
   static Pose pose_of(const double* parameters) {
     PoseParameters pose;

@@ -66,9 +66,9 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
   const double prior_weight = 1.0 / (sigma_rate * sigma_rate);
   Pose pose = initial_T_camera_world;
   Eigen::Vector3d rho = Eigen::Vector3d::Zero();
-  PoseInformation marginal = PoseInformation::Zero();
+  Matrix9 H = Matrix9::Zero();  // kept after the loop: the last iteration's normal equations
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    Matrix9 H = Matrix9::Zero();
+    H.setZero();
     Vector9 g = Vector9::Zero();
     double cost = 0.0;
     for (size_t i = 0; i < observations.size(); ++i) {
@@ -83,7 +83,6 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
     g.tail<3>() += prior_weight * rho;
     const Eigen::LDLT<Matrix9> solver(H);
     if (solver.info() != Eigen::Success) return {initial_T_camera_world, Eigen::Vector3d::Zero()};
-    marginal = marginal_pose_information(H);
     // r = sqrt(info) (measured - projection): the Gauss-Newton step solves H delta = -J^T r.
     const Vector9 delta = solver.solve(-g);
     if (!delta.allFinite()) return {initial_T_camera_world, Eigen::Vector3d::Zero()};
@@ -95,7 +94,7 @@ RollingShutterPose refine_pose_and_rotation_rate(const PinholeCamera& camera, do
     rho += delta.tail<3>();
     if (delta.norm() < 1e-10) break;
   }
-  return {pose, rho, marginal};
+  return {pose, rho, iterations > 0 ? marginal_pose_information(H) : PoseInformation::Zero()};
 }
 
 }  // namespace pspslam

@@ -1,5 +1,6 @@
 #include "pspslam/session/run_report.h"
 
+#include <spdlog/fmt/fmt.h>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
@@ -20,13 +21,6 @@
 
 namespace pspslam {
 namespace {
-
-// A weight as the user typed it: 0.1, not 0.100000.
-std::string format_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
 
 double median(std::vector<double> values) { return upper_median(values); }
 
@@ -207,8 +201,7 @@ void print_frames_and_map(const RunReportInput& input, std::ostream& out) {
           ? "the best " + std::to_string(system.local_ba_keyframes) + " covisible keyframes"
           : "every covisible keyframe";
   if (system.ba_tracking_factors > 0.0)
-    window +=
-        ", with tracking's factors (weight " + format_number(system.ba_tracking_factors) + ")";
+    window += fmt::format(", with tracking's factors (weight {:g})", system.ba_tracking_factors);
   std::snprintf(line, sizeof(line),
                 "mapping:      %zu keyframes processed, %zu culled; points: %zu triangulated, "
                 "%zu fused, %zu culled, %zu BA outlier observations removed; %zu local BAs cut "

@@ -251,20 +251,17 @@ std::optional<TrackedMotion> Tracker::tracked_motion(const Frame& frame) {
   std::shared_ptr<KeyFrame> previous = last_keyframe_.lock();
   if (!previous || previous->is_bad()) previous = reference_keyframe_;
   if (!previous || previous->is_bad()) return std::nullopt;
-  const PosePrior* prior = motion_prior_ ? &*motion_prior_ : nullptr;
   TrackedMotion motion;
   motion.previous_keyframe_id = previous->id();
   motion.T_camera_previous = frame.T_camera_world() * previous->T_world_camera();
   // The rolling-shutter refinement ran last: its information, the rate marginalised, is the
-  // pose's; a global shutter has only the pose-only optimisation's.
-  motion.information =
-      rolling_shutter_information_.isZero()
-          ? frame_pose_information(frame, options_.pose_optimizer, pose_buffers_, prior)
-          : rolling_shutter_information_;
-  if (prior != nullptr && !rolling_shutter_information_.isZero()) {
-    motion.information +=
-        pose_information(frame.camera().pinhole, frame.camera().bf,
-                         options_.pose_optimizer.depth_noise, frame.T_camera_world(), {}, prior);
+  // pose's; a global shutter has only the pose-only optimisation's. Either way with the prior's.
+  if (rolling_shutter_information_.isZero()) {
+    motion.information = frame_pose_information(frame, options_.pose_optimizer, pose_buffers_,
+                                                motion_prior_ ? &*motion_prior_ : nullptr);
+  } else {
+    motion.information = rolling_shutter_information_;
+    if (motion_prior_) motion.information += prior_information(*motion_prior_);
   }
   return motion;
 }

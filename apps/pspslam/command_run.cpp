@@ -121,6 +121,7 @@ struct RunFlags {
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
   std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
+  double new_map_after = kNewMapAfterSeconds;
   std::string loop_closing = "auto";
   std::string save_map;
   std::string load_map;
@@ -155,6 +156,7 @@ RunSettings run_settings(const RunFlags& flags) {
   settings.live_camera = !flags.camera.empty();
   settings.local_mapping = !flags.no_local_mapping;
   settings.relocalization = !flags.no_relocalization;
+  settings.new_map_after = flags.new_map_after;
   settings.loop_closing = flags.loop_closing;
   settings.mask_margin = flags.mask_margin;
   settings.segment_every = flags.segment_every;
@@ -508,6 +510,12 @@ void add_map_options(CLI::App* app, RunFlags& flags) {
                   "shipped models/vocabulary/orb_k10_l5.pspvoc)");
   app->add_flag("--no-relocalization", flags.no_relocalization,
                 "do not relocalise when tracking is lost (and do not load the vocabulary)");
+  app->add_option("--new-map-after", flags.new_map_after,
+                  "SECONDS lost, with relocalisation failing in every map, before tracking starts "
+                  "a new map in the atlas; loop closing merges it when a place is recognised "
+                  "across the two (0: never; the run stays lost until relocalised)")
+      ->check(in_range(0.0, 3600.0))
+      ->capture_default_str();
   app->add_option("--loop-closing", flags.loop_closing,
                   "loop closing thread (detection, essential-graph correction, global BA); auto = "
                   "on when the vocabulary file exists")

@@ -87,6 +87,7 @@ const std::vector<std::pair<std::string, OptionSetter>>& run_options() {
       {"realtime", &set_value<&RunSettings::realtime, bool>},
       {"local_mapping", &set_value<&RunSettings::local_mapping, bool>},
       {"relocalization", &set_value<&RunSettings::relocalization, bool>},
+      {"new_map_after", &set_value<&RunSettings::new_map_after, double>},
       {"loop_closing", &set_value<&RunSettings::loop_closing, std::string>},
       {"mask_margin", &set_value<&RunSettings::mask_margin, int>},
       {"segment_every", &set_value<&RunSettings::segment_every, int>},

@@ -139,6 +139,9 @@ def test_bad_options_raise(small_sequence):
         pspslam.System(sequence, mask_margin=101)
     with pytest.raises(TypeError, match=re.escape("mask_margin: expected an int, got str")):
         pspslam.System(sequence, mask_margin="3")
+    with pytest.raises(ValueError, match=r"^new_map_after: expected a value in \[0(\.0)?, "
+                       r"3600(\.0)?\], got -1(\.0)?$"):
+        pspslam.System(sequence, new_map_after=-1.0)
     with pytest.raises(ValueError, match=re.escape(
             "mode: expected off | semantic | geometry | full | exhaustive | auto, got 'fast'")):
         pspslam.System(sequence, mode="fast")

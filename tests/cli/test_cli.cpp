@@ -915,6 +915,71 @@ TEST(CliRun, MonocularFramesBeforeTheMapStartArePlacedInIt) {
   EXPECT_LT(placed_max, 0.008) << "the frames tracked after: " << rest_rms;
 }
 
+// The atlas, on a loop that turns 1.5 times (450 frames): one turn is frames 0-299, and from
+// frame 300 the camera sees the start again. Per sensor:
+// - two sessions: the first maps frames 0-149 and saves the map; the second loads it and starts at
+//   frame 220, which the first never saw. Relocalisation fails for a second, a new map starts,
+//   and it merges into the loaded one when the camera reaches its area. The merged trajectory is
+//   in the loaded map's frame, as accurate as a single session over the same frames (measured:
+//   RGB-D 3.7 against 6.8 mm, monocular 4.9 against 6.0 mm);
+// - one session with frames 150-219 black: relocalisation gives up, a second map starts at frame
+//   220 and merges back (RGB-D 10.7 mm, monocular 6.9 mm over the 380 frames with a pose).
+TEST(CliRun, AtlasStartsNewMapsThatMergeWhenTheCameraReturns) {
+  const auto dir = testing::make_temp_dir("cli_atlas");
+  const std::string sequence = (dir / "seq").string();
+  const Result synth = pspslam("synth --out " + sequence +
+                               " --frames 450 --bodies 0 --trajectory loop --loop-turns 1.5 "
+                               "--seed 2");
+  ASSERT_EQ(synth.status, 0) << synth.output;
+  for (const std::string sensor : {"rgbd", "monocular"}) {
+    SCOPED_TRACE(sensor);
+    const std::string run = "run --sequence " + sequence + " --dynamic off" +
+                            (sensor == "monocular" ? " --sensor monocular" : "") + " --out ";
+    const auto out = [&](const char* name) { return dir / (sensor + "_" + name); };
+    const auto stats_of = [&](const char* name) {
+      return nlohmann::json::parse(read_text(out(name) / "stats.json"));
+    };
+    const auto first_map = out("first.map");
+    Result r =
+        pspslam(run + out("first").string() + " --max-frames 150 --save-map " + first_map.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = pspslam(run + out("second").string() + " --start-frame 220 --load-map " +
+                first_map.string() + " --save-map " + out("atlas.map").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(
+        contains(r.output, "atlas:        2 maps, 1 merge(s); the final files are in map 0"))
+        << r.output;
+    const nlohmann::json second = stats_of("second");
+    EXPECT_EQ(second["atlas"]["maps_tracked_in"], 2);
+    EXPECT_EQ(second["atlas"]["merges"][0]["from"], 1);
+    EXPECT_EQ(second["atlas"]["merges"][0]["into"], 0);
+    EXPECT_EQ(second["atlas"]["maps_at_end"], nlohmann::json({0}));
+    EXPECT_EQ(second["atlas"]["other_map_poses"], 0);
+    // The frames without a pose are those of the second spent relocalising before the new map.
+    EXPECT_LE(second["lost_frames"].get<int>(), 30);
+    EXPECT_EQ(second["atlas"]["main_map_poses"].get<int>() + second["lost_frames"].get<int>(), 230);
+    r = pspslam(run + out("single").string() + " --start-frame 220");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const double single = stats_of("single")["ate_refined"]["rmse"].get<double>();
+    EXPECT_LE(second["ate_refined"]["rmse"].get<double>(), 1.5 * single) << "single " << single;
+    // The saved atlas holds the merged map alone; localising in it from the start needs no new map.
+    r = pspslam(run + out("again").string() + " --max-frames 60 --localization --load-map " +
+                out("atlas.map").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(stats_of("again")["lost_frames"], 0) << r.output;
+
+    r = pspslam(run + out("blackout").string() + " --blackout 150:70");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const nlohmann::json blackout = stats_of("blackout");
+    EXPECT_EQ(blackout["atlas"]["maps_tracked_in"], 2) << r.output;
+    EXPECT_EQ(blackout["atlas"]["merge_count"], 1) << r.output;
+    EXPECT_EQ(blackout["atlas"]["maps"][1]["first_frame"], 220) << r.output;
+    EXPECT_EQ(blackout["lost_frames"], 70);
+    EXPECT_EQ(blackout["atlas"]["main_map_poses"], 380);
+    EXPECT_LT(blackout["ate_refined"]["rmse"].get<double>(), 0.02) << r.output;
+  }
+}
+
 // --video: a synthetic sequence's colour images encoded as MJPG (OpenCV's own
 // encoder, in every build) run monocular to a trajectory timed by the video (1/30 s apart from
 // 0); `eval` next to the run's stats.json aligns it with Sim(3) by itself and says why.
@@ -980,8 +1045,9 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   EXPECT_EQ(report["ate"]["alignment_reason"], "the run's stats.json says sensor monocular");
   EXPECT_LT(report["ate"]["error_m"]["rmse"].get<double>(), 0.05);
 
-  // The same frames from the folder, colour only. Black frames two frames after the map started
-  // lose a map of a few keyframes: it is started again after them rather than relocalised into.
+  // The same frames from the folder, colour only. Without the atlas (--new-map-after 0), black
+  // frames two frames after the map started lose a map of a few keyframes: it is started again
+  // after them rather than relocalised into.
   const Result folder = pspslam("run --sequence " + (dir / "seq").string() +
                                 " --sensor monocular --dynamic off --out " + (dir / "f").string());
   ASSERT_EQ(folder.status, 0) << folder.output;
@@ -991,7 +1057,7 @@ TEST(CliRun, VideoFileRunsMonocularAndEvalAlignsWithSim3) {
   const size_t first_placed = folder_stats["monocular"]["placed_before_initialisation"];
   const Result blackout = pspslam(
       "run --sequence " + (dir / "seq").string() + " --sensor monocular --dynamic off --blackout " +
-      std::to_string(started + 2) + ":10 --out " + (dir / "b").string());
+      std::to_string(started + 2) + ":10 --new-map-after 0 --out " + (dir / "b").string());
   ASSERT_EQ(blackout.status, 0) << blackout.output;
   const nlohmann::json restarted = nlohmann::json::parse(read_text(dir / "b" / "stats.json"));
   EXPECT_EQ(restarted["monocular"]["map_restarts"], 1) << blackout.output;

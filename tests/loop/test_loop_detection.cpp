@@ -90,7 +90,18 @@ class LoopWorld {
                            monocular_scale(k));
     return (depth_scale * true_pose(k) * monocular_drift(k).inverse()).rescaled_pose();
   }
-  Pose estimated_pose(int k) const { return monocular_ ? monocular_pose(k) : drifted_pose(k); }
+  Pose estimated_pose(int k) const {
+    const Pose pose = monocular_ ? monocular_pose(k) : drifted_pose(k);
+    return (Sim3(pose) * map_offset_.inverse()).rescaled_pose();
+  }
+
+  // From the next keyframe on, tracking is in a new map of the atlas whose world is
+  // `offset` · (the first map's world): it knows none of the earlier points.
+  void start_new_map(Map& map, const Sim3& offset) {
+    map.open_new_map();
+    map_offset_ = offset;
+    local_points_.clear();
+  }
 
   // Median over the keyframe's map points of (depth in the keyframe) / (true depth): the scale
   // of the map around it.
@@ -147,13 +158,14 @@ class LoopWorld {
       }
     }
     auto keyframe = std::make_shared<KeyFrame>(static_cast<std::uint64_t>(k), frame);
+    keyframe->set_map(map.active_map(), false);
     map.add_keyframe(keyframe);
     for (int j = 0; j < keyframe->size(); ++j) {
       auto point = keyframe->map_point(j);
       if (!point) {
         // Monocular: where triangulation in the drifted map would have put it.
         const Eigen::Vector3d position =
-            monocular_ ? monocular_drift(k) * landmarks_[landmark_of[j]].position
+            monocular_ ? map_offset_ * (monocular_drift(k) * landmarks_[landmark_of[j]].position)
                        : keyframe->unproject_world(j);
         point = std::make_shared<MapPoint>(map.next_map_point_id(), position, keyframe);
         keyframe->add_map_point(j, point);
@@ -187,6 +199,7 @@ class LoopWorld {
   std::vector<Landmark> landmarks_;
   std::map<int, LocalPoint> local_points_;
   std::map<int, std::vector<int>> landmarks_seen_by_;  // keyframe -> landmark of each keypoint
+  Sim3 map_offset_;  // the current map's world from the first map's
 };
 
 double center_error(const Pose& a, const Pose& b) {
@@ -383,6 +396,75 @@ TEST(LoopDetection, MonocularLoopIsASimilarityAndItsScaleIsCorrected) {
   // its points were made by the keyframes just before it, at 0.88-0.90).
   EXPECT_NEAR(depth_ratio_before, LoopWorld::monocular_scale(detected_at), 0.03);
   EXPECT_NEAR(world.depth_ratio(*loop->current), LoopWorld::monocular_scale(matched), 0.02);
+}
+
+// Two maps of the atlas: tracking was lost for good after keyframe 11 and a new map started at
+// keyframe 12 in a world of its own (turned 50°, moved 1.5 m and, monocular, half the scale).
+// The revisit of the first map's wall is found as a loop across the two maps, and the
+// correction brings the whole second map into the first one's frame and labels.
+void expect_maps_merge(bool monocular) {
+  const auto place = PlaceRecognition::load(default_vocabulary_path());
+  Map map;
+  LoopWorld world(11, monocular);
+  LoopClosingOptions options;
+  if (monocular) close_loops_with_scale(options);
+  LoopDetector detector(map, *place, options.detector);
+  const Sim3 offset(Eigen::AngleAxisd(50.0 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ())
+                        .toRotationMatrix(),
+                    Eigen::Vector3d(1.5, -0.5, 0.2), monocular ? 0.5 : 1.0);
+  std::optional<DetectedLoop> loop;
+  int detected_at = -1;
+  for (int k = 0; k <= kKeyframesPerTurn * 3 / 2 && !loop; ++k) {
+    if (k == 12) world.start_new_map(map, offset);
+    const auto keyframe = world.add_keyframe(k, map, *place);
+    const auto candidates = detector.detect(keyframe);
+    if (!candidates.empty()) loop = detector.verify(keyframe, candidates);
+    detected_at = k;
+  }
+  ASSERT_TRUE(loop.has_value()) << "no place recognised across the maps; consistent candidates "
+                                << detector.stats().consistent_candidates;
+  EXPECT_EQ(loop->current->map_id(), 1u);
+  EXPECT_EQ(loop->matched->map_id(), 0u);
+  EXPECT_LE(detected_at, kKeyframesPerTurn + 6);
+  // Current camera coordinates are in the second map's units: half the first map's.
+  if (monocular) {
+    const int matched = static_cast<int>(loop->matched->id());
+    EXPECT_NEAR(loop->S_current_matched.scale,
+                0.5 * LoopWorld::monocular_scale(detected_at) / LoopWorld::monocular_scale(matched),
+                0.05);
+  }
+
+  // Before: the second map's keyframes are metres from where the first map has them.
+  const auto distance_to_first_map = [&](int k) {
+    const auto keyframe = map.keyframe(static_cast<std::uint64_t>(k));
+    const Pose in_first_map = monocular ? LoopWorld::monocular_pose(k) : LoopWorld::drifted_pose(k);
+    return center_error(keyframe->T_camera_world(), in_first_map);
+  };
+  EXPECT_GT(distance_to_first_map(12), 1.0);
+  EXPECT_GT(distance_to_first_map(detected_at), 1.0);
+  LoopEdges edges;
+  const LoopCorrectionReport report = correct_loop(map, *loop, edges, options.correction, {});
+  ASSERT_TRUE(report.merge.has_value());
+  EXPECT_EQ(report.merge->from, 1u);
+  EXPECT_EQ(report.merge->into, 0u);
+  EXPECT_TRUE(report.graph.usable);
+  EXPECT_GT(report.fused_points + report.replaced_points, 100u) << "the seam's duplicates";
+  EXPECT_EQ(map.map_ids(), (std::vector<std::uint32_t>{0}));
+  EXPECT_EQ(map.current_map_of(1), 0u);
+  EXPECT_FALSE(map.keyframe(12)->is_anchor());
+  EXPECT_TRUE(map.keyframe(0)->is_anchor());
+  // After: every keyframe of the second map is where the first map (with its drift) has it,
+  // to within the drift the loop correction spreads (a few centimetres per keyframe).
+  for (int k = 12; k <= detected_at; ++k) {
+    EXPECT_EQ(map.keyframe(static_cast<std::uint64_t>(k))->map_id(), 0u);
+    EXPECT_LT(distance_to_first_map(k), 0.25) << "keyframe " << k;
+  }
+}
+
+TEST(LoopDetection, APlaceSeenInAnotherMapMergesItRgbd) { expect_maps_merge(false); }
+
+TEST(LoopDetection, APlaceSeenInAnotherMapMergesItMonocularBySimilarity) {
+  expect_maps_merge(true);
 }
 
 TEST(LoopDetection, NoLoopBeforeTheRevisit) {

@@ -58,16 +58,17 @@ class InputError(Exception):
 
 
 # ---------------------------------------------------------------------------------------------
-# Map file (src/pspslam/persistence/map_file.cpp, version 1)
+# Map file (src/pspslam/persistence/map_file.cpp, versions 1 and 2)
 
 MAP_MAGIC = b"PSPSLMAP"
-MAP_VERSION = 1
+MAP_VERSIONS = (1, 2)
 MAP_HEADER = struct.Struct("<8sIIQQ")
 MAP_CAMERA = struct.Struct("<5d3Id")
 MAP_COUNTS = struct.Struct("<QQ")
 MAP_POINT = np.dtype([("id", "<u8"), ("position", "<f8", (3,)), ("reference_keyframe", "<u8"),
                       ("first_keyframe", "<u8")])
-MAP_KEYFRAME_HEAD = struct.Struct("<QQd12dQI")
+MAP_KEYFRAME_HEAD = {1: struct.Struct("<QQd12dQI"),  # ... parent, keypoints
+                     2: struct.Struct("<QQd12dQIII")}  # ... parent, map id, anchor, keypoints
 MAP_KEYPOINT = np.dtype([("x", "<f4"), ("y", "<f4"), ("size", "<f4"), ("angle", "<f4"),
                          ("response", "<f4"), ("octave", "<i4"), ("depth", "<f4"),
                          ("point", "<u8")])
@@ -95,6 +96,7 @@ class MapKeyFrame:
     T_camera_world: np.ndarray  # 4x4
     parent: int
     keypoints: np.ndarray  # MAP_KEYPOINT records
+    map_id: int = 0  # the map of the atlas (version 1: one map)
 
 
 @dataclass
@@ -141,9 +143,9 @@ def checked_map_payload(data, path):
         raise InputError(f"{path}: truncated map file (the header needs {MAP_HEADER.size} bytes, "
                          f"the file has {len(data)})")
     _, version, _, payload_bytes, checksum = MAP_HEADER.unpack_from(data)
-    if version != MAP_VERSION:
+    if version not in MAP_VERSIONS:
         raise InputError(f"{path}: unsupported map format version {version} (this tool reads "
-                         f"version {MAP_VERSION})")
+                         f"versions {MAP_VERSIONS[0]} to {MAP_VERSIONS[-1]})")
     payload = data[MAP_HEADER.size:]
     if len(payload) < payload_bytes:
         raise InputError(f"{path}: truncated map file (header announces {payload_bytes} payload "
@@ -153,7 +155,7 @@ def checked_map_payload(data, path):
                          f"map payload")
     if fnv1a64(payload) != checksum:
         raise InputError(f"{path}: map checksum mismatch: the file is corrupt")
-    return payload
+    return payload, version
 
 
 def read_map(path):
@@ -164,7 +166,8 @@ def read_map(path):
     except OSError as error:
         raise InputError(f"{path}: cannot read map file ({error.strerror}); write it with "
                          f"`pspslam run ... --save-map {path}`") from None
-    reader = PayloadReader(checked_map_payload(data, path), path)
+    payload, version = checked_map_payload(data, path)
+    reader = PayloadReader(payload, path)
     camera = MapCamera(*reader.unpack(MAP_CAMERA, "camera"))
     keyframe_count, point_count = reader.unpack(MAP_COUNTS, "counts")
     if point_count * MAP_POINT.itemsize > len(reader.payload):
@@ -174,15 +177,17 @@ def read_map(path):
     keyframes = []
     for index in range(keyframe_count):
         what = f"keyframe {index} of {keyframe_count}"
-        head = reader.unpack(MAP_KEYFRAME_HEAD, what)
+        head = reader.unpack(MAP_KEYFRAME_HEAD[version], what)
         keyframe_id, frame_id, timestamp = head[0], head[1], head[2]
         pose = np.eye(4)
         pose[:3, :3] = np.array(head[3:12]).reshape(3, 3)
         pose[:3, 3] = head[12:15]
-        parent, keypoint_count = head[15], head[16]
+        parent, keypoint_count = head[15], head[-1]
+        map_id = head[16] if version >= 2 else 0
         keypoints = reader.records(MAP_KEYPOINT, keypoint_count, f"{what} keypoints")
         reader.take(keypoint_count * DESCRIPTOR_BYTES, f"{what} descriptors")
-        keyframes.append(MapKeyFrame(keyframe_id, frame_id, timestamp, pose, parent, keypoints))
+        keyframes.append(MapKeyFrame(keyframe_id, frame_id, timestamp, pose, parent, keypoints,
+                                     map_id))
     if reader.offset != len(reader.payload):
         raise InputError(f"{path}: {len(reader.payload) - reader.offset} map payload bytes left "
                          f"after the last keyframe")

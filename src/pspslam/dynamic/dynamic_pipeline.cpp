@@ -242,7 +242,9 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     }
   }
   if (result.T_world_camera) {
-    if (last_pose_ && last_pose_id_ + 1 == current_id_) {
+    // A frame that started a map is in a new world frame: no velocity across it.
+    if (last_pose_ && last_pose_id_ + 1 == current_id_ &&
+        result.method != TrackingMethod::kInitialization) {
       velocity_ = last_pose_->inverse() * *result.T_world_camera;  // T_last_current
     } else {
       velocity_.reset();
@@ -322,8 +324,11 @@ void DynamicPipeline::collect_reference_views() {
     map_references_->pool(*prior_pose(), pool_size, views_);
     return;
   }
+  // Keyframes of another map of the atlas are in another world frame.
+  const std::uint32_t active_map = map_.active_map();
   for (const auto& reference : references_) {
-    if (const auto keyframe = reference.keyframe.lock(); keyframe && !keyframe->is_bad())
+    const auto keyframe = reference.keyframe.lock();
+    if (keyframe && !keyframe->is_bad() && keyframe->map_id() == active_map)
       views_.push_back({keyframe->T_world_camera(), reference.depth});
   }
 }

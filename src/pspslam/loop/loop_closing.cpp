@@ -116,10 +116,11 @@ void LoopClosing::close_loop(const DetectedLoop& loop) {
   detector_.loop_closed_at(loop.current->id());
   {
     std::lock_guard lock(mutex_);
-    ++stats_.loops_closed;
+    ++(report.merge ? stats_.maps_merged : stats_.loops_closed);
     stats_.last_correction = report;
   }
-  if (options_.global_bundle_adjustment) start_global_bundle_adjustment();
+  // On the map the loop closed (after a merge: the merged one); other maps are not touched.
+  if (options_.global_bundle_adjustment) start_global_bundle_adjustment(loop.matched->map_id());
   if (local_mapping_ != nullptr) local_mapping_->release();
 }
 
@@ -130,17 +131,18 @@ void LoopClosing::stop_global_bundle_adjustment() {
   abort_global_ba_ = false;
 }
 
-void LoopClosing::start_global_bundle_adjustment() {
+void LoopClosing::start_global_bundle_adjustment(std::uint32_t map_id) {
   {
     std::lock_guard lock(mutex_);
     global_ba_running_ = true;
     ++stats_.global_ba_started;
   }
-  global_ba_thread_ = std::jthread([this] { run_global_bundle_adjustment(); });
+  global_ba_thread_ = std::jthread([this, map_id] { run_global_bundle_adjustment(map_id); });
 }
 
-void LoopClosing::run_global_bundle_adjustment() {
+void LoopClosing::run_global_bundle_adjustment(std::uint32_t map_id) {
   GlobalBaOptions options = options_.global_ba;
+  options.map_id = map_id;
   const auto aborted = [this] { return abort_global_ba_.load(); };
   options.should_stop = aborted;
   const GlobalBaResult result = solve_global_bundle_adjustment(*map_, options);

@@ -8,7 +8,8 @@
 //   // destructor: aborts a running global BA and joins both threads
 //
 // Per keyframe: detection (BoW + covisibility consistency), verification (3D-3D RANSAC, guided
-// matching, projection), and for an accepted loop the correction: a running global BA is
+// matching, projection), and for an accepted loop (or a place in another map of the atlas, which
+// merges the two: map_merge.h) the correction: a running global BA is
 // aborted, local mapping is stopped, correct_loop() rewrites the map under Map::update_mutex(),
 // local mapping is released, and a new global BA starts on its own thread. That global BA works
 // on a snapshot and takes the mutex only to write its result back (with local mapping stopped),
@@ -56,6 +57,7 @@ void close_loops_with_scale(LoopClosingOptions& options);
 struct LoopClosingStats {
   LoopDetectorStats detector;
   std::uint64_t loops_closed = 0;
+  std::uint64_t maps_merged = 0;  // places recognised across two maps of the atlas
   std::uint64_t global_ba_started = 0;
   std::uint64_t global_ba_applied = 0;
   std::uint64_t global_ba_aborted = 0;
@@ -87,9 +89,9 @@ class LoopClosing {
   void run(const std::stop_token& stop);
   void process(const std::shared_ptr<KeyFrame>& keyframe);
   void close_loop(const DetectedLoop& loop);
-  void start_global_bundle_adjustment();
+  void start_global_bundle_adjustment(std::uint32_t map_id);
   void stop_global_bundle_adjustment();
-  void run_global_bundle_adjustment();
+  void run_global_bundle_adjustment(std::uint32_t map_id);
   // Stops local mapping and waits until it has; false when asked to abort meanwhile.
   bool stop_local_mapping(const std::function<bool()>& abort);
 

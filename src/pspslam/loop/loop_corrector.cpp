@@ -3,11 +3,13 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "pspslam/loop/loop_detector.h"
+#include "pspslam/loop/map_merge.h"
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
@@ -130,12 +132,13 @@ EssentialGraph essential_graph_nodes(Map& map, const DetectedLoop& loop,
     if (keyframe->is_bad()) continue;
     essential.node_of[keyframe->id()] = essential.graph.nodes.size();
     essential.keyframes.push_back(keyframe);
-    // The loop keyframe is held fixed (gauge), as in ORB-SLAM2.
+    // The loop keyframe is held fixed (gauge), as in ORB-SLAM2; so are the other maps of the
+    // atlas, which the loop does not touch.
     const auto moved = hood.corrected.find(keyframe->id());
     essential.graph.nodes.push_back(
         {keyframe->id(),
          moved != hood.corrected.end() ? moved->second : Sim3(keyframe->T_camera_world()),
-         keyframe->id() == loop.matched->id()});
+         keyframe->id() == loop.matched->id() || keyframe->map_id() != loop.matched->map_id()});
   }
   return essential;
 }
@@ -232,19 +235,32 @@ void apply_optimised_poses(Map& map, const EssentialGraph& essential,
 
 }  // namespace
 
-LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges& loop_edges,
+LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& detected, LoopEdges& loop_edges,
                                   const LoopCorrectionOptions& options,
                                   const std::function<void()>& on_corrected) {
   const auto start = std::chrono::steady_clock::now();
   LoopCorrectionReport report;
   std::lock_guard lock(map.update_mutex());
 
+  // 0. A place recognised in another map of the atlas: that map takes the current one in first
+  // (map_merge.h), and the rest is the loop seen from there.
+  std::optional<DetectedLoop> merged;
+  if (detected.current->map_id() != detected.matched->map_id()) {
+    measure_correction(detected, report);
+    report.merge = MapMerge{.from = detected.current->map_id(),
+                            .into = detected.matched->map_id(),
+                            .current_keyframe = detected.current->id(),
+                            .matched_keyframe = detected.matched->id()};
+    merged = bring_into_matched_map(map, detected);
+  }
+  const DetectedLoop& loop = merged ? *merged : detected;
+
   // 1. The current keyframe's neighbourhood moves with it: S_i_world' = T_i_current ·
   // S_current_world' (ORB-SLAM2 CorrectLoop). On a monocular map the similarity also rescales the
   // neighbourhood to the loop side's units; its keyframes take the rescaled poses and its points
   // p' = S_i_world'⁻¹ · T_i_world · p, which keeps every projection as it was.
   Neighbourhood hood = corrected_neighbourhood(loop);
-  measure_correction(loop, report);
+  if (!merged) measure_correction(loop, report);
   move_neighbourhood(hood);
   report.propagated_keyframes = hood.connected.size();
 

@@ -1,6 +1,7 @@
 #pragma once
 
-// Loop correction (ORB-SLAM2 LoopClosing::CorrectLoop): moves the current keyframe's
+// Loop correction (ORB-SLAM2 LoopClosing::CorrectLoop), which also completes a merge of two maps
+// of the atlas (map_merge.h): moves the current keyframe's
 // neighbourhood to where the loop's similarity says it is (rescaled too on a monocular map),
 // fuses the duplicated map points, adds the loop edges and spreads the loop error over the map
 // with an essential-graph optimisation (Sim(3) nodes when pose_graph.optimize_scale).
@@ -14,14 +15,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <utility>
 #include <vector>
 
+#include "pspslam/map/map.h"
 #include "pspslam/optimize/pose_graph_optimization.h"
 
 namespace pspslam {
 
-class Map;
 struct DetectedLoop;
 
 struct LoopCorrectionOptions {
@@ -46,6 +48,9 @@ struct LoopCorrectionReport {
   double correction_deg = 0.0;    // and turned
   double correction_scale = 1.0;  // and how its neighbourhood was resized (monocular)
   double seconds = 0.0;           // wall time with Map::update_mutex() held
+  // Set when the loop joined two maps of the atlas (loop/map_merge.h); the correction figures
+  // above are then the merge's transform.
+  std::optional<MapMerge> merge;
 };
 
 LoopCorrectionReport correct_loop(Map& map, const DetectedLoop& loop, LoopEdges& loop_edges,

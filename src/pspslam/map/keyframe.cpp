@@ -290,7 +290,7 @@ void KeyFrame::erase_child(std::uint64_t child_id) {
 }
 
 void KeyFrame::set_bad() {
-  if (id_ == 0) return;
+  if (is_anchor()) return;
   const auto self = shared_from_this();
   for (const auto& other : covisibles()) other->erase_connection(id_);
   for (const auto& point : map_points()) {

@@ -67,6 +67,17 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   Eigen::Vector3d camera_center() const;
   void set_pose(const Pose& T_camera_world);
 
+  // --- the atlas (thread-safe): the map this keyframe belongs to (Map's atlas, map.h), and
+  // whether it anchors that map: the map's first keyframe, held fixed by bundle adjustment and
+  // never culled. A merge relabels the keyframes of the map it brings in, whose anchor stops
+  // anchoring.
+  std::uint32_t map_id() const { return map_id_.load(std::memory_order_acquire); }
+  bool is_anchor() const { return anchor_.load(std::memory_order_acquire); }
+  void set_map(std::uint32_t map_id, bool anchor) {
+    map_id_.store(map_id, std::memory_order_release);
+    anchor_.store(anchor, std::memory_order_release);
+  }
+
   // --- what tracking measured; set once, before the keyframe enters the map (not saved with it)
   void set_tracked_motion(const TrackedMotion& motion) { tracked_motion_ = motion; }
   const std::optional<TrackedMotion>& tracked_motion() const { return tracked_motion_; }
@@ -130,8 +141,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void erase_child(std::uint64_t child_id);
 
   // Removes the keyframe from the graph: drops its observations from its map points,
-  // its covisibility edges, and re-attaches its children to the spanning tree. The first
-  // keyframe is never made bad (it anchors the map). The caller erases it from the Map.
+  // its covisibility edges, and re-attaches its children to the spanning tree. A map's anchor
+  // is never made bad. The caller erases it from the Map.
   void set_bad();
   bool is_bad() const;
 
@@ -159,6 +170,8 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const std::shared_ptr<const ScalePyramid> pyramid_;
   const FeatureGrid grid_;
   std::optional<TrackedMotion> tracked_motion_;
+  std::atomic<std::uint32_t> map_id_{0};
+  std::atomic<bool> anchor_{false};
 
   std::mutex bow_mutex_;  // serialises compute_bow; readers use bow_ready_
   std::atomic<bool> bow_ready_{false};

@@ -13,9 +13,24 @@ namespace pspslam {
 class KeyFrame;
 class MapPoint;
 
+// A merge of the atlas: map `from` was brought into map `into`'s frame and relabelled.
+struct MapMerge {
+  std::uint32_t from = 0;
+  std::uint32_t into = 0;
+  std::uint64_t current_keyframe = 0;  // the keyframe that recognised the place (`from`'s side)
+  std::uint64_t matched_keyframe = 0;  // the keyframe it recognised (`into`'s side)
+};
+
 // Owner of all keyframes and map points (the only shared_ptr owner; everything else refers to
 // them by weak_ptr or id). Thread-safe. update_mutex() serialises "the map changes under you"
 // sections: tracking holds it for one frame, local mapping while it writes optimised values.
+//
+// The container is an atlas: every keyframe belongs to one map (KeyFrame::map_id), each with its
+// own world frame (and, monocular, scale). Maps share no points and no covisibility, so local
+// mapping, local BA and tracking's local map stay inside one without knowing of the others. The
+// keyframe database covers them all: relocalisation lands in any, loop closing merges two when
+// a keyframe of one recognises a place in the other (loop/map_merge.h). Tracking makes keyframes
+// in the active map.
 class Map {
  public:
   Map() = default;
@@ -54,7 +69,28 @@ class Map {
 
   std::mutex& update_mutex() { return update_mutex_; }
 
-  // Empties the map (a monocular restart); ids start from 0 again.
+  // --- the atlas
+  std::uint32_t active_map() const { return active_map_.load(std::memory_order_acquire); }
+  void set_active_map(std::uint32_t map_id) {
+    active_map_.store(map_id, std::memory_order_release);
+  }
+  // Makes a new, empty map active and returns its id (the same id again until a keyframe of it
+  // is added, so a start that fails leaves no gap).
+  std::uint32_t open_new_map();
+  size_t num_keyframes_in(std::uint32_t map_id) const;
+  // Ids of the maps that hold keyframes now, ascending.
+  std::vector<std::uint32_t> map_ids() const;
+  // The keyframes of `from` join `into` (their poses and points were moved into its frame first);
+  // `from`'s anchor stops anchoring and `into` becomes active if `from` was.
+  void merge_map(const MapMerge& merge);
+  std::vector<MapMerge> merges() const;
+  // The map a keyframe made in `map_id` belongs to now, after the merges since.
+  std::uint32_t current_map_of(std::uint32_t map_id) const;
+  // Removes `map_id`'s keyframes and the points they observe from the atlas (a start that
+  // failed); its anchor included.
+  void erase_map(std::uint32_t map_id);
+
+  // Empties the atlas (a monocular restart without the atlas); ids start from 0 again.
   void clear();
 
  private:
@@ -63,6 +99,10 @@ class Map {
   std::map<std::uint64_t, std::shared_ptr<MapPoint>> map_points_;
   std::vector<std::shared_ptr<MapPoint>> reference_map_points_;
   std::uint64_t max_keyframe_id_ = 0;
+  std::map<std::uint32_t, size_t> keyframes_per_map_;
+  std::uint32_t next_map_id_ = 0;  // above every map id with keyframes so far
+  std::vector<MapMerge> merges_;
+  std::atomic<std::uint32_t> active_map_{0};
   std::atomic<std::uint64_t> next_keyframe_id_{0};
   std::atomic<std::uint64_t> next_map_point_id_{0};
   std::mutex update_mutex_;

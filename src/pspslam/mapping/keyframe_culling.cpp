@@ -40,7 +40,7 @@ int cull_redundant_keyframes(Map& map, const std::shared_ptr<KeyFrame>& keyframe
                              const std::function<void(std::uint64_t)>& on_erased) {
   int culled = 0;
   for (const auto& candidate : keyframe->covisibles()) {
-    if (candidate->id() == 0 || candidate->is_bad()) continue;
+    if (candidate->is_anchor() || candidate->is_bad()) continue;
     if (!is_redundant(*candidate, options)) continue;
     const std::vector<std::shared_ptr<MapPoint>> points = candidate->map_points();
     map.erase_keyframe(candidate);

@@ -12,7 +12,7 @@ class KeyFrame;
 class Map;
 
 // ORB-SLAM2 KeyFrameCulling: erases from `map` each covisible keyframe of `keyframe` (never the
-// anchor, id 0) whose close map points are more than options.redundant_ratio redundant, i.e.
+// anchor of its map) whose close map points are more than options.redundant_ratio redundant, i.e.
 // observed by at least options.redundant_observers other keyframes at the same or a finer
 // pyramid level (one level of slack). Returns the number of keyframes erased; `on_erased` (may
 // be empty) is told each erased keyframe's id (e.g. to drop it from the KeyFrameDatabase).

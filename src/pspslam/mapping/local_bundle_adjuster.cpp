@@ -68,8 +68,8 @@ LocalWindow collect_window(const std::shared_ptr<KeyFrame>& keyframe,
   const auto add_keyframe = [&](const std::shared_ptr<KeyFrame>& kf, bool fixed) {
     keyframe_slot.emplace(kf->id(), window.keyframes.size());
     window.keyframes.push_back(kf);
-    // The anchor keyframe fixes the gauge (position, orientation and scale of the map).
-    window.problem.keyframes.push_back({kf->id(), kf->T_camera_world(), fixed || kf->id() == 0});
+    // The map's anchor keyframe fixes the gauge (position, orientation and scale of the map).
+    window.problem.keyframes.push_back({kf->id(), kf->T_camera_world(), fixed || kf->is_anchor()});
   };
   add_keyframe(keyframe, false);
   for (const auto& neighbour :

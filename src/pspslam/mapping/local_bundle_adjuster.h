@@ -39,7 +39,7 @@ struct LocalWindowOptions {
 
 // Local keyframes: `keyframe` and its covisible keyframes (LocalWindowOptions). Local points: all
 // their map points. Fixed: the keyframes that observe local points without being local, and the
-// anchor (id 0).
+// anchor of the map (KeyFrame::is_anchor).
 LocalBundleAdjustmentReport run_local_bundle_adjustment(Map& map,
                                                         const std::shared_ptr<KeyFrame>& keyframe,
                                                         const BaOptions& options,

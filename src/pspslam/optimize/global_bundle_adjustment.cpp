@@ -19,10 +19,11 @@ GlobalBaResult solve_global_bundle_adjustment(const Map& map, const GlobalBaOpti
   std::shared_ptr<const KeyFrame> any_keyframe;
   for (const auto& keyframe : map.keyframes()) {
     if (keyframe->is_bad()) continue;
+    if (options.map_id && keyframe->map_id() != *options.map_id) continue;
     const Pose T_camera_world = keyframe->T_camera_world();
     keyframe_slot.emplace(keyframe->id(), problem.keyframes.size());
-    // The first keyframe anchors the map (gauge), as in local BA.
-    problem.keyframes.push_back({keyframe->id(), T_camera_world, keyframe->id() == 0});
+    // Each map's first keyframe anchors it (gauge), as in local BA.
+    problem.keyframes.push_back({keyframe->id(), T_camera_world, keyframe->is_anchor()});
     result.T_camera_world_before.emplace(keyframe->id(), T_camera_world);
     any_keyframe = keyframe;
   }

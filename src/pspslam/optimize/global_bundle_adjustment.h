@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <unordered_map>
 
 #include "pspslam/core/types.h"
@@ -33,6 +34,8 @@ struct GlobalBaOptions {
   // covisible keyframes, few shared points) slide along their viewing direction, away from the
   // truth (tests/optimize/test_global_bundle_adjustment.cpp). Default as BaOptions: the u_r row.
   DepthNoiseModel depth_noise{.scale = 20.0};
+  // Only the keyframes of this map of the atlas (and the points they see); none: every map.
+  std::optional<std::uint32_t> map_id;
 };
 
 struct GlobalBaResult {

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -24,7 +25,7 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/map/scale_pyramid.h"
 
-// File format, version 1 (little-endian, no padding):
+// File format, version 2 (little-endian, no padding):
 //   header (32 bytes): char[8] "PSPSLMAP", u32 version, u32 reserved (0), u64 payload bytes,
 //                      u64 FNV-1a 64 of the payload
 //   payload:
@@ -34,9 +35,11 @@
 //              u64 first keyframe id
 //     keyframes per keyframe (ascending id): u64 id, u64 frame id, f64 timestamp,
 //              f64[12] T_camera_world (rotation row-major, then translation), u64 parent id
-//              (kNone: none), u32 keypoints N, then per keypoint f32 x, y, size, angle,
+//              (kNone: none), u32 map id and u32 anchor (0 or 1) in the atlas, u32 keypoints N,
+//              then per keypoint f32 x, y, size, angle,
 //              response, i32 octave, f32 depth, u64 map point id (kNone: none);
 //              then N x 32 descriptor bytes
+// Version 1 is version 2 without the map id and anchor: one map, anchored by its first keyframe.
 // Everything else (observations, descriptors and normals of points, covisibility) is derived
 // on load, so the file cannot contradict itself there.
 
@@ -47,7 +50,8 @@ static_assert(std::endian::native == std::endian::little,
               "the map file is little-endian and written by memcpy");
 
 constexpr std::array<char, 8> kMagic = {'P', 'S', 'P', 'S', 'L', 'M', 'A', 'P'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;
+constexpr std::uint32_t kOldestReadableVersion = 1;
 constexpr std::size_t kHeaderBytes = 32;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 constexpr std::size_t kKeypointBytes = 5 * 4 + 4 + 4 + 8;
@@ -153,6 +157,8 @@ struct PointRecord {
 struct KeyFrameRecord {
   std::uint64_t id = 0;
   std::uint64_t parent = kNone;
+  std::uint32_t map_id = 0;
+  std::optional<bool> anchor;  // none (version 1): the map's first keyframe
   KeyFrameData data;
   std::vector<std::uint64_t> point_ids;  // per keypoint
 };
@@ -188,6 +194,8 @@ std::size_t put_keyframe(Writer& out, const KeyFrame& keyframe,
   put_pose(out, keyframe.T_camera_world());
   const auto parent = keyframe.parent();
   out.put(parent && !parent->is_bad() ? parent->id() : kNone);
+  out.put(keyframe.map_id());
+  out.put(static_cast<std::uint32_t>(keyframe.is_anchor() ? 1 : 0));
   const int n = keyframe.size();
   out.put(static_cast<std::uint32_t>(n));
   const auto associations = keyframe.map_points();
@@ -233,8 +241,9 @@ std::string read_whole_file(const std::filesystem::path& file, const std::string
   return std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
 }
 
-// The payload of a file whose header (magic, version, size, checksum) holds.
-std::string_view checked_payload(const std::string& bytes, const std::string& prefix) {
+// The payload of a file whose header (magic, version, size, checksum) holds, and its version.
+std::pair<std::string_view, std::uint32_t> checked_payload(const std::string& bytes,
+                                                           const std::string& prefix) {
   if (bytes.size() >= kMagic.size() && !std::equal(kMagic.begin(), kMagic.end(), bytes.begin()))
     throw Error(prefix + "not a pspslam map (bad magic, expected \"PSPSLMAP\")");
   if (bytes.size() < kHeaderBytes) {
@@ -244,9 +253,10 @@ std::string_view checked_payload(const std::string& bytes, const std::string& pr
   Reader header(bytes.data(), kHeaderBytes, prefix);
   header.take(kMagic.size(), "magic");
   const auto version = header.get<std::uint32_t>("version");
-  if (version != kFormatVersion) {
+  if (version < kOldestReadableVersion || version > kFormatVersion) {
     throw Error(prefix + "unsupported format version " + std::to_string(version) +
-                " (this build reads version " + std::to_string(kFormatVersion) + ")");
+                " (this build reads versions " + std::to_string(kOldestReadableVersion) + " to " +
+                std::to_string(kFormatVersion) + ")");
   }
   header.get<std::uint32_t>("reserved");
   const auto payload_bytes = header.get<std::uint64_t>("payload size");
@@ -266,7 +276,7 @@ std::string_view checked_payload(const std::string& bytes, const std::string& pr
     throw Error(prefix + "checksum mismatch (stored " + hex64(stored_checksum) + ", computed " +
                 hex64(checksum) + "): the file is corrupt");
   }
-  return {payload, payload_bytes};
+  return {{payload, payload_bytes}, version};
 }
 
 void check_camera(Reader& in, const std::string& prefix, const CameraModel& camera,
@@ -339,8 +349,8 @@ void read_keypoints(Reader& in, int pyramid_levels,
     std::memcpy(record.data.descriptors.data, descriptors, std::size_t{n} * kDescriptorBytes);
 }
 
-void read_keyframes(Reader& in, std::uint64_t keyframe_count, int pyramid_levels,
-                    MapRecords& records) {
+void read_keyframes(Reader& in, std::uint32_t version, std::uint64_t keyframe_count,
+                    int pyramid_levels, MapRecords& records) {
   if (keyframe_count == 0) in.fail("no keyframes");
   if (keyframe_count > in.remaining() / 140)
     in.fail("keyframe count " + std::to_string(keyframe_count));
@@ -355,17 +365,25 @@ void read_keyframes(Reader& in, std::uint64_t keyframe_count, int pyramid_levels
     record.data.timestamp = in.get<double>("keyframe timestamp");
     record.data.T_camera_world = get_pose(in);
     record.parent = in.get<std::uint64_t>("keyframe parent");
+    if (version >= 2) {
+      record.map_id = in.get<std::uint32_t>("keyframe map id");
+      const auto anchor = in.get<std::uint32_t>("keyframe anchor");
+      if (anchor > 1)
+        in.fail("keyframe " + std::to_string(record.id) + " anchor " + std::to_string(anchor));
+      record.anchor = anchor == 1;
+    }
     read_keypoints(in, pyramid_levels, records.point_index, record);
   }
 }
 
 // The payload after the camera check: points, keyframes, and nothing left over.
-MapRecords read_records(Reader& in, const std::string& prefix, int pyramid_levels) {
+MapRecords read_records(Reader& in, std::uint32_t version, const std::string& prefix,
+                        int pyramid_levels) {
   MapRecords records;
   const auto keyframe_count = in.get<std::uint64_t>("keyframe count");
   const auto point_count = in.get<std::uint64_t>("map point count");
   read_points(in, point_count, records);
-  read_keyframes(in, keyframe_count, pyramid_levels, records);
+  read_keyframes(in, version, keyframe_count, pyramid_levels, records);
   if (in.remaining() != 0)
     in.fail(std::to_string(in.remaining()) + " bytes left after the last keyframe");
   for (const KeyFrameRecord& record : records.keyframes) {
@@ -428,7 +446,9 @@ MapFileSummary build_map(MapRecords& records, Map& map, std::shared_ptr<const Ca
   for (KeyFrameRecord& record : records.keyframes) {
     keyframes.push_back(
         std::make_shared<KeyFrame>(record.id, std::move(record.data), camera, pyramid));
-    map.add_keyframe(keyframes.back());
+    keyframes.back()->set_map(record.map_id, false);
+    map.add_keyframe(keyframes.back());  // anchors the first of each map
+    if (record.anchor) keyframes.back()->set_map(record.map_id, *record.anchor);
   }
   const std::vector<std::shared_ptr<MapPoint>> points = make_points(records, keyframes);
   MapFileSummary summary;
@@ -494,10 +514,10 @@ MapFileSummary load_map(const std::filesystem::path& file, Map& map,
                         std::shared_ptr<const ScalePyramid> pyramid) {
   const std::string prefix = "map file '" + file.string() + "': ";
   const std::string bytes = read_whole_file(file, prefix);
-  const std::string_view payload = checked_payload(bytes, prefix);
+  const auto [payload, version] = checked_payload(bytes, prefix);
   Reader in(payload.data(), payload.size(), prefix);
   check_camera(in, prefix, *camera, *pyramid);
-  MapRecords records = read_records(in, prefix, pyramid->levels);
+  MapRecords records = read_records(in, version, prefix, pyramid->levels);
 
   // The file is consistent: build the map.
   if (map.num_keyframes() != 0 || map.num_map_points() != 0)

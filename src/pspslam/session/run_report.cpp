@@ -450,6 +450,7 @@ void add_map_json(const RunReportInput& input, nlohmann::ordered_json& json) {
                  {"local_ba_cut_short", mapping.local_ba_cut_short}};
   json["loops"] = {{"enabled", system.place.loop_closing},
                    {"closed", mapping.loops_closed},
+                   {"maps_merged", mapping.map_merges.size()},
                    {"global_ba_applied", mapping.global_ba_applied}};
   if (mapping.loops_closed > 0) {
     // Map units: metres except for a monocular map; the scale is 1 except for a monocular map.
@@ -506,6 +507,7 @@ nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSec
   json["latency"] = {{"arrival_to_pose_ms", to_json(arrival_to_pose)},
                      {"mask_age_frames", to_json(summarize_latency(stats.mask_age_frames))}};
   add_map_json(input, json);
+  json["atlas"] = atlas_json(input.atlas);
   add_ate_json(reported.ate, monocular, json);
   return json;
 }
@@ -520,6 +522,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   const bool map_loaded = !input.options.system.map_file.empty();
   if (monocular) print_monocular_start(input.statistics, map_loaded, out);
   print_longest_lost_stretch(input.statistics, out);
+  print_atlas(input.atlas, out);
   out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
       << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv,\n"
       << "              run_config.yaml (the config used)\n";

@@ -7,6 +7,7 @@
 
 #include "pspslam/core/types.h"
 #include "pspslam/io/frame_source.h"
+#include "pspslam/session/atlas_report.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/system/system.h"
@@ -20,8 +21,9 @@ struct RunReportInput {
   const MappingStats& mapping;
   const FrameSource& source;   // ground truth, name and how the input ended
   const Trajectory& estimate;  // the poses of trajectory.txt
-  const Trajectory& refined;   // trajectory_refined.txt
-  size_t frames = 0;           // frames the run was to process (0: until the input ended)
+  const Trajectory& refined;   // trajectory_refined.txt (the main map of the atlas)
+  const AtlasSummary& atlas;
+  size_t frames = 0;  // frames the run was to process (0: until the input ended)
   // Timestamp of the first frame after a --blackout, when the run got there.
   std::optional<Timestamp> blackout_return;
   double seconds = 0.0;

@@ -17,6 +17,9 @@ inline constexpr int kLiveBackgroundNice = 10;
 // set of a small room leaves local BA cut short, and the capped window keeps up. Offline runs keep
 // ORB-SLAM2's whole window, which gives the better final trajectory.
 inline constexpr int kLiveLocalBaKeyframes = 10;
+// The atlas: seconds lost, with every relocalisation failing, before a new map starts
+// (TrackerOptions::new_map_after_seconds).
+inline constexpr double kNewMapAfterSeconds = 1.0;
 
 // The run settings that shape the System: `pspslam run`'s flags and the Python module's keywords
 // of the same names, with their defaults. Empty optionals take the run's default.
@@ -31,7 +34,8 @@ struct RunSettings {
   bool live_camera = false;  // frames from a live camera: live as with realtime
   bool local_mapping = true;
   bool relocalization = true;
-  std::string loop_closing = "auto";  // on | off | auto
+  double new_map_after = kNewMapAfterSeconds;  // 0: never start a new map
+  std::string loop_closing = "auto";           // on | off | auto
   int mask_margin = 5;
   int segment_every = 1;
   int cull_hits = 3;

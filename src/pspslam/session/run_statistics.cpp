@@ -79,7 +79,13 @@ void RunStatistics::count_pose(size_t index, const TrackResult& result) {
   const size_t placed = std::min(result.earlier_frames.size(), lost_);
   lost_ -= placed;
   posed_in_this_map_ += placed;
-  if (result.method == TrackingMethod::kInitialization) {
+  if (result.T_world_camera) {
+    MapFrames& map = frames_per_map_[result.map_id];
+    if (map.frames == 0) map.first_frame = index - std::min(index, result.earlier_frames.size());
+    map.frames += 1 + result.earlier_frames.size();
+    map.last_frame = index;
+  }
+  if (result.method == TrackingMethod::kInitialization && !result.new_map) {
     placed_before_initialisation_ = placed;
     initialised_at_ = index;
     tracked_since_initialisation_ = 0;

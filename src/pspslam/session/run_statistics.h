@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pspslam/dynamic/dynamic_mode.h"
+#include "pspslam/session/atlas_report.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/system/system.h"
 
@@ -59,8 +60,9 @@ class RunStatistics {
   size_t realtime_dropped() const { return realtime_dropped_; }
   std::optional<size_t> first_pose_after_blackout() const { return first_pose_after_blackout_; }
   const std::string& first_method_after_blackout() const { return first_method_after_blackout_; }
-  // Sequence index of the frame that started the map (the last start after a monocular restart)
-  // and the frames with a pose from there on, of the frames processed from there on.
+  // Sequence index of the frame that started the first map (the last start after a monocular
+  // restart; new maps of the atlas do not count) and the frames with a pose from there on, of
+  // the frames processed from there on.
   std::optional<size_t> initialised_at() const { return initialised_at_; }
   size_t tracked_since_initialisation() const { return tracked_since_initialisation_; }
   // Frames before the map's start that it placed (TrackResult::earlier_frames; monocular).
@@ -116,6 +118,8 @@ class RunStatistics {
   std::vector<size_t> masks_at_pace_level;
   size_t pace_level_changes = 0;
   int stale_mask_frames() const { return stale_mask_frames_; }
+  // The atlas: the frames each map held when they were tracked.
+  const std::map<std::uint32_t, MapFrames>& frames_per_map() const { return frames_per_map_; }
 
  private:
   void count_pose(size_t index, const TrackResult& result);
@@ -143,6 +147,7 @@ class RunStatistics {
   std::optional<LostStretch> current_lost_;
   std::optional<LostStretch> longest_lost_;
   size_t posed_in_this_map_ = 0;
+  std::map<std::uint32_t, MapFrames> frames_per_map_;
 };
 
 }  // namespace pspslam

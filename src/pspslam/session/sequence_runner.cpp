@@ -271,21 +271,38 @@ void SequenceRunner::write_images(const InputFrame& frame, const FrameReport& re
 
 void SequenceRunner::finish(double seconds) {
   const std::filesystem::path& out_dir = options_.outputs.folder;
-  write_tum_trajectory(out_dir / "keyframes.txt", system_->keyframe_trajectory());
-  const Trajectory refined = system_->refined_trajectory();
+  // The main map of the atlas (most poses) gives the run's files; maps that never merged with it
+  // get their own, since their world frames differ.
+  const std::vector<MapTrajectory> final_maps =
+      split_by_map(system_->refined_trajectory(), system_->refined_map_ids());
+  const Trajectory& refined = final_maps.front().poses;
+  write_tum_trajectory(out_dir / "keyframes.txt",
+                       system_->keyframe_trajectory(final_maps.front().map_id));
   write_tum_trajectory(out_dir / "trajectory_refined.txt", refined);
+  for (size_t m = 1; m < final_maps.size(); ++m) {
+    const std::uint32_t id = final_maps[m].map_id;
+    write_tum_trajectory(other_map_file(out_dir, "trajectory_refined", id), final_maps[m].poses);
+    write_tum_trajectory(other_map_file(out_dir, "keyframes", id),
+                         system_->keyframe_trajectory(id));
+  }
   if (options_.outputs.kitti_trajectory) {
     write_kitti_trajectory(out_dir / "trajectory_kitti.txt", estimate_);
     write_kitti_trajectory(out_dir / "trajectory_refined_kitti.txt", refined);
   }
   const MappingStats mapping = system_->mapping_stats();
   if (exporter_) write_map_exports(options_.outputs, *exporter_, system_->map(), out_);
+  const AtlasSummary atlas{.new_map_after_seconds = options_.system.tracker.new_map_after_seconds,
+                           .maps = statistics_.frames_per_map(),
+                           .merges = mapping.map_merges,
+                           .maps_at_end = mapping.maps,
+                           .final_maps = final_maps};
   write_run_report({.options = options_,
                     .statistics = statistics_,
                     .mapping = mapping,
                     .source = *input_.source,
                     .estimate = estimate_,
                     .refined = refined,
+                    .atlas = atlas,
                     .frames = frames_,
                     .blackout_return = blackout_return_,
                     .seconds = seconds,

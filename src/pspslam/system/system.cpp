@@ -40,8 +40,9 @@
 //                                  | LocalMapping::set_keyframe_listener (processed keyframes)
 //                                  v
 //   loop closing thread     LoopClosing (loop/): BoW detection with covisibility consistency,
-//                             3D-3D RANSAC verification; for a loop: stops local mapping,
-//                             correct_loop() under Map::update_mutex() (fusion, essential
+//                             3D-3D RANSAC verification (a place in another map of the atlas
+//                             merges the two first: loop/map_merge.h); for a loop: stops local
+//                             mapping, correct_loop() under Map::update_mutex() (fusion, essential
 //                             graph), re-anchors the tracker, releases local mapping
 //   global BA thread        started after each loop: solves on a snapshot, writes back under
 //                             Map::update_mutex() with local mapping stopped (docs/loop_closing.md)
@@ -245,6 +246,7 @@ System::System(const SystemConfig& config, SystemOptions requested)
                    .wait_for_local_mapping = [this] { mapping_->wait_until_idle(); }});
   if (!options.map_file.empty()) {
     load_map(options.map_file, *map_, camera_, pyramid_);
+    map_->set_active_map(map_->map_ids().front());
     if (place_) {
       for (const auto& keyframe : map_->keyframes()) {
         keyframe->compute_bow(place_->vocabulary(), place_->direct_index_level());
@@ -297,9 +299,10 @@ std::pair<size_t, size_t> System::save_map(const std::filesystem::path& file) {
   return {summary.keyframes, summary.map_points};
 }
 
-Trajectory System::keyframe_trajectory() const {
+Trajectory System::keyframe_trajectory(std::optional<std::uint32_t> map_id) const {
   Trajectory trajectory;
   for (const auto& keyframe : map_->keyframes()) {
+    if (map_id && keyframe->map_id() != *map_id) continue;
     trajectory.push_back({keyframe->timestamp(), keyframe->T_world_camera()});
   }
   return trajectory;
@@ -309,6 +312,8 @@ MappingStats System::mapping_stats() const {
   MappingStats stats;
   stats.keyframes_in_map = map_->num_keyframes();
   stats.map_points = map_->num_map_points();
+  stats.maps = map_->map_ids();
+  stats.map_merges = map_->merges();
   mapping_->fill(stats);
   if (loop_closing_) {
     const LoopClosingStats loop = loop_closing_->stats();

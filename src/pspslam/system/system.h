@@ -5,18 +5,19 @@
 #include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/core/types.h"
+#include "pspslam/map/map.h"
 #include "pspslam/system/system_options.h"
 #include "pspslam/system/tracking_module.h"
 
 namespace pspslam {
 
 class LoopClosing;
-class Map;
 class PlaceRecognition;
 struct CameraModel;
 struct ScalePyramid;
@@ -43,6 +44,9 @@ struct MappingStats {
   double last_loop_correction_m = 0.0;      // how far the last loop moved its keyframe
   double last_loop_correction_scale = 1.0;  // and how it resized its neighbourhood (monocular)
   double last_global_ba_seconds = 0.0;
+  // The atlas: the maps that hold keyframes now, and the merges so far (Map::merges).
+  std::vector<std::uint32_t> maps;
+  std::vector<MapMerge> map_merges;
 };
 
 // Reads every module's section of `config` as a System does: a bad key or value is an error
@@ -99,11 +103,16 @@ class System {
   // Returns the number of keyframes and map points written.
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
 
-  // Keyframe poses (T_world_camera), by keyframe id.
-  Trajectory keyframe_trajectory() const;
+  // Keyframe poses (T_world_camera), by keyframe id; only those of one map of the atlas when
+  // `map_id` is given.
+  Trajectory keyframe_trajectory(std::optional<std::uint32_t> map_id = std::nullopt) const;
   // All tracked frames, re-expressed through their BA-refined reference keyframes (see
   // Tracker::refined_trajectory); call after shutdown().
   Trajectory refined_trajectory() const { return tracking_->tracker().refined_trajectory(); }
+  // Per pose of refined_trajectory(), the map of the atlas it is in at the end.
+  std::vector<std::uint32_t> refined_map_ids() const {
+    return tracking_->tracker().refined_map_ids();
+  }
   MappingStats mapping_stats() const;
   const Map& map() const { return *map_; }
   // Vocabulary + keyframe database; null when PlaceOptions needs no vocabulary.

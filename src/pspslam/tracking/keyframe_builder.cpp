@@ -22,6 +22,7 @@ std::shared_ptr<KeyFrame> create_keyframe(Frame& frame, Map& map, bool initial, 
   }
   auto keyframe = std::make_shared<KeyFrame>(map.next_keyframe_id(), frame);
   if (motion) keyframe->set_tracked_motion(*motion);
+  keyframe->set_map(map.active_map(), /*anchor=*/false);  // the map's first becomes its anchor
   map.add_keyframe(keyframe);
 
   // Existing matches become observations of the new keyframe.

@@ -10,7 +10,8 @@ namespace pspslam {
 class Frame;
 class Map;
 
-// Turns a tracked frame (it must have a pose) into a keyframe that is complete in the map:
+// Turns a tracked frame (it must have a pose) into a keyframe that is complete in the map's
+// active map (Map::active_map):
 // map points are created from depth for keypoints that have none, nearest first (all of them
 // for the initial keyframe; otherwise every close one, at least `min_new_points`, as ORB-SLAM2's
 // RGB-D keyframe creation), the frame's inlier matches become observations, descriptors,

@@ -79,7 +79,12 @@ class MonocularMapInitializer final : public MapInitializer {
     }
     std::vector<std::shared_ptr<KeyFrame>> keyframes = build_map(frame, map, two_view);
     if (keyframes.empty()) {
-      map.clear();
+      // Only the map this start made goes; the atlas's other maps stay.
+      if (map.map_ids().size() <= 1) {
+        map.clear();
+      } else {
+        map.erase_map(map.active_map());
+      }
       frame.clear_pose();
       std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
       take_as_reference(frame);
@@ -88,6 +93,16 @@ class MonocularMapInitializer final : public MapInitializer {
       reference_.reset();
     }
     return keyframes;
+  }
+
+  void observe(const Frame& frame) override {
+    if (frame.size() < options_.min_keypoints) {
+      reset();
+    } else if (!reference_ || match_with_reference(frame) < options_.min_matches) {
+      take_as_reference(frame);
+    } else {
+      remember_between(frame);
+    }
   }
 
   std::vector<EarlierFramePose> take_earlier_frames() override { return std::move(earlier_); }
@@ -243,6 +258,7 @@ class MonocularMapInitializer final : public MapInitializer {
 
     GlobalBaOptions ba;
     ba.iterations = options_.bundle_adjustment_iterations;
+    ba.map_id = first->map_id();
     const GlobalBaResult adjusted = solve_global_bundle_adjustment(map, ba);
     if (adjusted.completed) apply_global_bundle_adjustment(map, adjusted);
 

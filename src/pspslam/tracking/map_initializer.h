@@ -45,6 +45,11 @@ class MapInitializer {
   virtual std::vector<std::shared_ptr<KeyFrame>> initialize(Frame& frame, Map& map,
                                                             InitializationProgress& progress) = 0;
 
+  // A lost frame before a new map may start (TrackerOptions::new_map_after_seconds): kept as
+  // initialize() would keep a frame that cannot start the map yet, so that the map, once
+  // started, can place it (monocular). Does nothing by default.
+  virtual void observe(const Frame& /*frame*/) {}
+
   // After a successful initialize(): the frames before `frame` that the new map can place, oldest
   // first (monocular: the two-view pair's first frame and the frames between the pair, localised
   // on the first map's points). Each call hands them over once; empty for a one-frame start.

@@ -67,11 +67,11 @@ TrackResult Tracker::track(Frame frame) {
   result.num_keypoints = frame.size();
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (initialize(frame, result)) {
-      state_ = TrackingState::kOk;
-      result.method = TrackingMethod::kInitialization;
-      result.keyframe_inserted = true;
-      result.num_inliers = frame.size();
+    if (relocalize_in_atlas(frame)) {
+      result.method = TrackingMethod::kRelocalisation;
+      finish_tracked_frame(frame, result);
+    } else {
+      start_map(frame, result);
     }
   } else {
     if (last_frame_) replace_replaced_points(*last_frame_);
@@ -96,31 +96,17 @@ TrackResult Tracker::track(Frame frame) {
       }
     }
     if (ok) ok = track_local_map(frame);
-    rolling_shutter_information_.setZero();
     if (ok) {
-      const RollingShutterPose refined = refine_frame_rotation_rate(
-          frame, options_.pose_optimizer, options_.rotation_rate_sigma, pose_buffers_);
-      angular_velocity_ += refined.rate_correction;
-      rolling_shutter_information_ = refined.pose_information;
-    }
-    if (ok) {
-      state_ = TrackingState::kOk;
-      result.num_inliers = 0;
-      for (int i = 0; i < frame.size(); ++i) {
-        if (frame.map_points[i] && !frame.outlier[i]) ++result.num_inliers;
-      }
-      guard_against_movers(frame, result);
-      maybe_insert_keyframe(frame, result);
+      finish_tracked_frame(frame, result);
     } else {
-      state_ = TrackingState::kLost;
-      result.method = TrackingMethod::kNone;
-      frame.clear_pose();
-      result.restart_due = map_.num_keyframes() <= initializer_->restart_when_lost_below();
+      on_lost(frame, result);
     }
   }
 
   result.state = state_;
+  result.map_id = map_.active_map();
   if (state_ == TrackingState::kOk && frame.has_pose()) {
+    lost_since_.reset();
     result.T_world_camera = frame.T_world_camera();
     if (last_tracked_pose_ && last_frame_ && last_frame_->has_pose()) {
       velocity_ = orthonormalized(frame.T_camera_world() * last_frame_->T_camera_world().inverse());
@@ -130,7 +116,8 @@ TrackResult Tracker::track(Frame frame) {
     last_tracked_pose_ = frame.T_camera_world();
     anchors_.push_back({frame.timestamp(), reference_keyframe_,
                         frame.T_camera_world() * reference_keyframe_->T_world_camera(),
-                        frame.T_camera_world(), result.keyframe_inserted, map_epoch_});
+                        frame.T_camera_world(), result.keyframe_inserted, map_epoch_,
+                        result.map_id});
   } else {
     velocity_.reset();
     angular_velocity_.setZero();
@@ -141,6 +128,77 @@ TrackResult Tracker::track(Frame frame) {
   }
   last_frame_.emplace(std::move(frame));
   return result;
+}
+
+void Tracker::finish_tracked_frame(Frame& frame, TrackResult& result) {
+  rolling_shutter_information_.setZero();
+  const RollingShutterPose refined = refine_frame_rotation_rate(
+      frame, options_.pose_optimizer, options_.rotation_rate_sigma, pose_buffers_);
+  angular_velocity_ += refined.rate_correction;
+  rolling_shutter_information_ = refined.pose_information;
+  state_ = TrackingState::kOk;
+  result.num_inliers = 0;
+  for (int i = 0; i < frame.size(); ++i) {
+    if (frame.map_points[i] && !frame.outlier[i]) ++result.num_inliers;
+  }
+  guard_against_movers(frame, result);
+  maybe_insert_keyframe(frame, result);
+}
+
+void Tracker::on_lost(Frame& frame, TrackResult& result) {
+  rolling_shutter_information_.setZero();
+  state_ = TrackingState::kLost;
+  result.method = TrackingMethod::kNone;
+  frame.clear_pose();
+  const bool young =
+      map_.num_keyframes_in(map_.active_map()) <= initializer_->restart_when_lost_below();
+  if (options_.new_map_after_seconds <= 0.0) {
+    result.restart_due = young;
+    return;
+  }
+  if (!lost_since_) {
+    lost_since_ = frame.timestamp();
+    initializer_->reset();
+  }
+  if (!young && frame.timestamp() - *lost_since_ < options_.new_map_after_seconds) {
+    initializer_->observe(frame);  // a monocular start can place the frames lost meanwhile
+    return;
+  }
+  // A new map in the atlas; the frames tracked so far stay in theirs, and the frames the
+  // initialiser kept since the loss wait for it.
+  forget_tracking_state(/*keep_initializer=*/true);
+  ++map_epoch_;  // the new map has its own world frame: no correction is interpolated across
+  ++new_maps_;
+  map_.open_new_map();
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outlier.begin(), frame.outlier.end(), 0);
+  opening_new_map_ = true;
+  start_map(frame, result);
+}
+
+bool Tracker::relocalize_in_atlas(Frame& frame) {
+  if (!relocalizer_ || map_.num_keyframes() == 0) return false;
+  if (relocalize(frame) && track_local_map(frame)) {
+    initializer_->reset();
+    opening_new_map_ = false;
+    return true;
+  }
+  frame.clear_pose();
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  std::fill(frame.outlier.begin(), frame.outlier.end(), 0);
+  reference_keyframe_.reset();
+  return false;
+}
+
+bool Tracker::start_map(Frame& frame, TrackResult& result) {
+  if (!initialize(frame, result)) return false;
+  result.new_map = opening_new_map_;
+  opening_new_map_ = false;
+  state_ = TrackingState::kOk;
+  result.method = TrackingMethod::kInitialization;
+  result.keyframe_inserted = true;
+  result.num_inliers = frame.size();
+  return true;
 }
 
 Trajectory Tracker::refined_trajectory() const {
@@ -160,6 +218,13 @@ Trajectory Tracker::refined_trajectory() const {
       frame.T_world_camera_keyframe_now = reference->T_world_camera();
   }
   return refine_by_keyframe_corrections(frames);
+}
+
+std::vector<std::uint32_t> Tracker::refined_map_ids() const {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(anchors_.size());
+  for (const FrameAnchor& anchor : anchors_) ids.push_back(map_.current_map_of(anchor.map_id));
+  return ids;
 }
 
 void Tracker::on_map_corrected() {
@@ -197,7 +262,8 @@ bool Tracker::initialize(Frame& frame, TrackResult& result) {
   for (const EarlierFramePose& earlier : initializer_->take_earlier_frames()) {
     result.earlier_frames.push_back({earlier.timestamp, earlier.T_camera_world.inverse()});
     anchors_.push_back({earlier.timestamp, first, earlier.T_camera_world * first->T_world_camera(),
-                        earlier.T_camera_world, earlier.is_first_keyframe, map_epoch_});
+                        earlier.T_camera_world, earlier.is_first_keyframe, map_epoch_,
+                        first->map_id()});
   }
   reference_keyframe_ = keyframes.back();
   last_keyframe_ = reference_keyframe_;
@@ -210,6 +276,12 @@ bool Tracker::initialize(Frame& frame, TrackResult& result) {
 }
 
 void Tracker::restart() {
+  forget_tracking_state();
+  anchors_.clear();
+  ++restarts_;
+}
+
+void Tracker::forget_tracking_state(bool keep_initializer) {
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   velocity_.reset();
@@ -221,9 +293,10 @@ void Tracker::restart() {
   last_keyframe_frame_id_ = 0;
   last_recovery_frame_id_ = 0;
   local_map_ = LocalMap(options_.max_local_keyframes);
-  anchors_.clear();
-  initializer_->reset();
-  ++restarts_;
+  if (!keep_initializer) initializer_->reset();
+  lost_since_.reset();
+  predicted_pose_.reset();
+  mover_guard_.reset();
 }
 
 void Tracker::replace_replaced_points(Frame& frame) const {
@@ -351,6 +424,7 @@ bool Tracker::relocalize(Frame& frame) {
   if (!relocalized.success) return false;
   reference_keyframe_ = relocalized.keyframe;
   last_recovery_frame_id_ = frame.id();
+  map_.set_active_map(reference_keyframe_->map_id());  // the atlas's map it found the camera in
   return true;
 }
 
@@ -416,7 +490,7 @@ void Tracker::maybe_insert_keyframe(Frame& frame, TrackResult& result) {
   evidence.frame_id = frame.id();
   evidence.last_keyframe_frame_id = last_keyframe_frame_id_;
   evidence.last_relocalisation_frame_id = last_recovery_frame_id_;
-  evidence.keyframes_in_map = static_cast<int>(map_.num_keyframes());
+  evidence.keyframes_in_map = static_cast<int>(map_.num_keyframes_in(map_.active_map()));
   evidence.tracked_inliers = result.num_inliers;
   const int min_observations = evidence.keyframes_in_map <= 2 ? 2 : 3;
   evidence.reference_tracked_points =

@@ -52,6 +52,12 @@ struct TrackerOptions {
   // weakly seen tilt rate follow noise (docs/decisions/rolling-shutter.md).
   double rotation_rate_sigma = 0.03;
   RelocalizerOptions relocalizer;
+  // The atlas (map/map.h): a tracker lost for this long (seconds of the sequence's clock) whose
+  // relocalisation in every map failed meanwhile starts a new map, and a monocular map lost while
+  // it is too young to relocalise in (MapInitializer::restart_when_lost_below) does so at once
+  // and keeps its poses. 0: never; the tracker stays lost until relocalised, and a young
+  // monocular map is emptied and started again (TrackResult::restart_due).
+  double new_map_after_seconds = 0.0;
   // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).
   MoverGuardOptions mover_guard;
 };
@@ -101,17 +107,24 @@ struct TrackResult {
   // The pose is the motion model's prediction: the optimised one followed a moving cluster
   // (MoverGuard).
   bool pose_held = false;
+  // The map of the atlas the pose is in (Map::active_map), as it was when the frame was tracked.
+  std::uint32_t map_id = 0;
+  // The frame started a map while others existed (TrackerOptions::new_map_after_seconds).
+  bool new_map = false;
 };
 
 // Tracking of each frame (ORB-SLAM2 semantics): map initialisation by the sensor's
 // MapInitializer (the first frame with enough depth, or two monocular views), constant-velocity
 // motion model, reference-keyframe fallback, local map tracking, keyframe decision. When
 // tracking fails the frame is reported lost and the next frames are relocalised against the
-// whole map through the keyframe database (Relocalizer, when a PlaceRecognition is given), else /
+// whole atlas through the keyframe database (Relocalizer, when a PlaceRecognition is given), else /
 // then against the last reference keyframe (PnP-RANSAC from brute-force matches, since the last
-// pose may be stale). No new map is started, so all poses stay in one world frame, except that
-// a monocular map lost while it has at most MapInitializer::restart_when_lost_below() keyframes
-// is restarted (TrackResult::restart_due).
+// pose may be stale). With TrackerOptions::new_map_after_seconds, a tracker that stays lost
+// starts a new map in the atlas, and while it starts it every frame is first relocalised in the
+// maps there are (a return to a known place joins that map instead). Without it no new map is
+// started, so all poses stay in one world frame, except that a monocular map lost while it has
+// at most MapInitializer::restart_when_lost_below() keyframes is restarted
+// (TrackResult::restart_due).
 //
 // Not thread-safe: one thread calls track(). It holds map.update_mutex() while it works on a
 // frame, so local mapping cannot rewrite poses or points under it.
@@ -133,6 +146,8 @@ class Tracker {
   // (refine_by_keyframe_corrections; culled keyframes give none). Lost frames are absent, as in
   // track(). Call when local mapping is idle or stopped.
   Trajectory refined_trajectory() const;
+  // Per pose of refined_trajectory(), the map of the atlas it is in now (after the merges).
+  std::vector<std::uint32_t> refined_map_ids() const;
 
   // Keyframe poses were corrected behind the tracker's back (loop closing, global BA): the last
   // tracked pose is re-expressed through its reference keyframe, as ORB-SLAM2 does, so that the
@@ -160,12 +175,25 @@ class Tracker {
   // out of refined_trajectory(), since the new map has its own world frame (and scale).
   void restart();
   int restarts() const { return restarts_; }
+  // Maps started after the first (TrackerOptions::new_map_after_seconds).
+  int new_maps() const { return new_maps_; }
 
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
 
  private:
   bool initialize(Frame& frame, TrackResult& result);
+  // initialize(), and the frame's result when it starts the map.
+  bool start_map(Frame& frame, TrackResult& result);
+  // The tracked frame's last steps: rolling-shutter rate, inliers, movers, keyframe decision.
+  void finish_tracked_frame(Frame& frame, TrackResult& result);
+  // While a new map is starting: the frame relocalised in the atlas's maps instead.
+  bool relocalize_in_atlas(Frame& frame);
+  // Lost and relocalisation failed: a new map when it is due (TrackerOptions).
+  void on_lost(Frame& frame, TrackResult& result);
+  // Forgets the frame-to-frame state (not the frames tracked so far), and the initialiser's
+  // frames unless `keep_initializer`.
+  void forget_tracking_state(bool keep_initializer = false);
   bool track_with_motion_model(Frame& frame);
   bool track_reference_keyframe(Frame& frame, bool recovering);
   bool relocalize(Frame& frame);
@@ -210,6 +238,9 @@ class Tracker {
   std::unique_ptr<Relocalizer> relocalizer_;  // null without a vocabulary
   std::unique_ptr<MapInitializer> initializer_;
   int restarts_ = 0;
+  int new_maps_ = 0;
+  std::optional<Timestamp> lost_since_;  // the first frame of the current loss
+  bool opening_new_map_ = false;         // a map beyond the first is starting
 
   struct FrameAnchor {
     Timestamp timestamp = 0.0;
@@ -218,9 +249,10 @@ class Tracker {
     Pose T_camera_world;           // as tracked
     bool became_keyframe = false;  // `reference` is the keyframe made from this frame
     int map_epoch = 0;
+    std::uint32_t map_id = 0;  // the map of the atlas it was tracked in
   };
   std::vector<FrameAnchor> anchors_;
-  int map_epoch_ = 0;  // map corrections so far (on_map_corrected calls)
+  int map_epoch_ = 0;  // map corrections and new maps so far
 
   // Reused per-frame buffers (no allocation per keypoint).
   FramePoseBuffers pose_buffers_;

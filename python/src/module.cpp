@@ -224,6 +224,12 @@ void register_result(py::module_& m) {
           "(timestamps, poses) of earlier frames placed by the frame that started a monocular "
           "map; empty otherwise")
       .def_property_readonly(
+          "map_id", [](const PyResult& r) { return r.report.tracking.map_id; },
+          "the map of the atlas the pose is in, as the frame was tracked (maps merge later)")
+      .def_property_readonly(
+          "new_map", [](const PyResult& r) { return r.report.tracking.new_map; },
+          "the frame started a map while others existed (new_map_after seconds lost)")
+      .def_property_readonly(
           "restarted", [](const PyResult& r) { return r.report.tracking.restart_due; },
           "a monocular map was lost while young and starts anew: the poses "
           "so far belong to the old map")

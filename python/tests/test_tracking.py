@@ -114,3 +114,22 @@ def test_ate_and_rpe_match_the_cli_eval(synthetic_sequence, cli_run):
     assert pspslam.ate(gt, rows)["rmse"] == ate["rmse"]
     rpe = pspslam.rpe(gt, est, delta=10, unit="f")
     assert rpe["translation"]["count"] > 0
+
+
+def test_tracking_lost_for_long_starts_a_new_map(synthetic_sequence):
+    """Black frames lose tracking; without relocalisation, once new_map_after seconds have passed
+    the next frame with enough depth starts map 1, and the frames after it are tracked there."""
+    sequence = pspslam.read_sequence(synthetic_sequence)
+    frames = list(sequence)
+    results = []
+    with pspslam.System(sequence, mode="off", relocalization=False, new_map_after=0.2) as slam:
+        for index, frame in enumerate(frames):
+            image, depth = np.array(frame.image), np.array(frame.depth)
+            if 20 <= index < 30:  # a third of a second without a picture
+                image, depth = np.zeros_like(image), np.zeros_like(depth)
+            results.append(slam.track(image, depth, timestamp=frame.timestamp))
+    assert all(r.map_id == 0 and r.pose is not None for r in results[1:20])
+    assert all(r.pose is None for r in results[20:30])
+    assert results[30].new_map and results[30].method == "initialization"
+    assert sum(r.new_map for r in results) == 1
+    assert all(r.map_id == 1 and r.pose is not None for r in results[30:])

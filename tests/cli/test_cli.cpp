@@ -610,6 +610,11 @@ TEST(CliRun, FlagValuesAreCheckedBeforeAnyWork) {
   EXPECT_EQ(r.output,
             "error: pspslam run: --ba-tracking-factors: must be a number in [0, 1e+06], got '-1' "
             "(see 'pspslam run --help')\n");
+  r = pspslam(run + "--new-map-after -1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output,
+            "error: pspslam run: --new-map-after: must be a number in [0, 3600], got '-1' (see "
+            "'pspslam run --help')\n");
   r = pspslam(run + "--local-ba-fixed-keyframes -3");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.output,

@@ -6,6 +6,10 @@ import * as THREE from 'three';
 import { frustumPoints, lineThrough, makeView, poseMatrix } from '/scene.js';
 
 const FATE_COLOURS = ['#00d200', '#ffd700', '#a03cff', '#00ffff'];
+// Keyframe frusta by the atlas map they belong to (map id modulo the palette): map 0 keeps the
+// single-map colour, the others stay clear of the other layers' colours.
+const MAP_COLOURS = [0x8ab4ff, 0xd67cff, 0xf2e35c, 0xff8fc4, 0x7be3c3, 0xb0b0ff];
+const mapColour = (id) => MAP_COLOURS[id % MAP_COLOURS.length];
 const $ = (id) => document.getElementById(id);
 const body = document.body;
 
@@ -126,8 +130,7 @@ const view = makeView($('scene'));
 const layers = {
   points: new THREE.Points(new THREE.BufferGeometry(),
                            new THREE.PointsMaterial({ size: 0.02, color: 0xc8c8c8 })),
-  keyframes: new THREE.LineSegments(new THREE.BufferGeometry(),
-                                    new THREE.LineBasicMaterial({ color: 0x8ab4ff })),
+  keyframes: new THREE.Group(),  // one LineSegments per map of the atlas
   covisibility: new THREE.LineSegments(new THREE.BufferGeometry(),
                                        new THREE.LineBasicMaterial({ color: 0x3a9d54 })),
   trajectory: lineThrough([], 0xe8a33d),
@@ -145,6 +148,43 @@ let currentPosition = null;
 function setPoints(layer, points) {
   layer.geometry.dispose();
   layer.geometry = new THREE.BufferGeometry().setFromPoints(points);
+}
+
+const keyframeMaterials = MAP_COLOURS.map((color) => new THREE.LineBasicMaterial({ color }));
+function setKeyframes(poses, mapIds) {
+  for (const child of layers.keyframes.children) child.geometry.dispose();
+  layers.keyframes.clear();
+  const posesByMap = {};
+  poses.forEach((pose, i) => (posesByMap[mapIds[i]] ??= []).push(pose));
+  for (const [id, mapPoses] of Object.entries(posesByMap)) {
+    const geometry = new THREE.BufferGeometry().setFromPoints(frustumPoints(mapPoses, 0.08));
+    layers.keyframes.add(
+        new THREE.LineSegments(geometry, keyframeMaterials[Number(id) % MAP_COLOURS.length]));
+  }
+}
+
+// The maps holding keyframes (id and keyframe count) and the merges so far. Maps are in
+// different world frames until merged: the colours tell which frusta belong together.
+function showAtlas(mapIds, merges) {
+  const keyframesPerMap = {};
+  for (const id of mapIds) keyframesPerMap[id] = (keyframesPerMap[id] ?? 0) + 1;
+  const ids = Object.keys(keyframesPerMap).map(Number).sort((a, b) => a - b);
+  $('maps').innerHTML = '';
+  for (const id of ids) {
+    const item = $('maps').appendChild(document.createElement('li'));
+    const swatch = item.appendChild(document.createElement('span'));
+    swatch.style.background = `#${mapColour(id).toString(16).padStart(6, '0')}`;
+    item.append(`map ${id} `);
+    item.appendChild(document.createElement('b')).textContent =
+        `${keyframesPerMap[id]} keyframe${keyframesPerMap[id] === 1 ? '' : 's'}`;
+  }
+  $('merges').innerHTML = '';
+  for (const merge of merges) {
+    $('merges').appendChild(document.createElement('li')).textContent =
+        `map ${merge.from} merged into map ${merge.into} at keyframe ${merge.current_keyframe}`;
+  }
+  body.dataset.maps = ids.length;
+  body.dataset.merges = merges.length;
 }
 
 function setCurrentCamera(pose) {
@@ -169,7 +209,10 @@ async function loadMap(version) {
   mapBusy = true;
   try {
     const response = await fetch(`/api/live/map?v=${version}`);
-    if (response.ok) showMap(await response.json());
+    if (response.ok) {
+      showMap(await response.json());
+      body.dataset.mapShown = version;
+    }
   } catch {
     // The run ended and its server closed while this map was on its way: the last map shown
     // stays (the event stream's error handler says whether the run finished).
@@ -184,7 +227,7 @@ function showMap(map) {
   layers.points.geometry = new THREE.BufferGeometry();
   layers.points.geometry.setAttribute('position',
                                       new THREE.Float32BufferAttribute(map.positions, 3));
-  setPoints(layers.keyframes, frustumPoints(map.keyframes, 0.08));
+  setKeyframes(map.keyframes, map.keyframe_maps);
   const centres = map.keyframes.map((pose) => new THREE.Vector3(...pose.p));
   setPoints(layers.covisibility, map.edges.flatMap(([a, b]) => [centres[a], centres[b]]));
   setPoints(layers.trajectory, map.trajectory.map((p) => new THREE.Vector3(...p)));
@@ -195,6 +238,7 @@ function showMap(map) {
   body.dataset.mapPoints = map.positions.length / 3;
   body.dataset.keyframes = map.keyframes.length;
   body.dataset.covisibilityEdges = map.edges.length;
+  showAtlas(map.keyframe_maps, map.merges);
   if (!framed && centres.length >= 2 && map.positions.length) {
     // Look from above and behind the first keyframe (SLAM's z forward is -z here) towards the
     // map's median point: the median ignores the few far points a bounding box would chase.
@@ -274,6 +318,7 @@ async function main() {
       showFrame(event.frame, event.state.frame_version);
     if (event.state.map_version && event.state.map_version !== mapVersion) {
       mapVersion = event.state.map_version;
+      body.dataset.mapVersion = mapVersion;
       loadMap(mapVersion);
     }
     body.dataset.liveReady = 'true';

@@ -1,8 +1,9 @@
 // Drives the live page of `pspslam run --viewer --viewer-paused` in headless chromium
 // (playwright-core from web/node_modules, Debian's /usr/bin/chromium) and prints what it saw as
-// one JSON line; test_cli (live_viewer_test.cpp) asserts on it.
-// Usage: node live_page.mjs PLAYWRIGHT_CORE_DIR URL SCREENSHOT.png
-const [playwrightDir, url, screenshot] = process.argv.slice(2);
+// one JSON line; test_cli (test_live_viewer.cpp) asserts on it. CHECK: `controls` (the default:
+// pause, step, toggles) or `atlas` (run to the end, the maps listed).
+// Usage: node live_page.mjs PLAYWRIGHT_CORE_DIR URL SCREENSHOT.png [CHECK]
+const [playwrightDir, url, screenshot, check = 'controls'] = process.argv.slice(2);
 const { chromium } = await import(`${playwrightDir}/index.mjs`);
 
 const seen = {};
@@ -16,10 +17,28 @@ const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 // Held: the run loop waits after the frame the page shows.
 const held = `document.body.dataset.runState === 'paused' &&
               document.body.dataset.frame === document.body.dataset.heldFrame`;
-try {
-  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
-  page.on('pageerror', (error) => { seen.page_error = String(error); });
-  await page.goto(url);
+// 3D view: pixels of one colour (within 2 per channel) in the WebGL canvas. The lines are drawn
+// in their exact colour (measured: the same count at 2 as at 24); a looser match also counted
+// the odd blend of other layers (CI: 2 "green" pixels with the edges off).
+const colourPixels = (page, rgb) => page.evaluate((rgb) => {
+  const gl = document.querySelector('#scene canvas');
+  const copy = document.createElement('canvas');
+  copy.width = gl.width;
+  copy.height = gl.height;
+  const g = copy.getContext('2d');
+  g.drawImage(gl, 0, 0);
+  const pixels = g.getImageData(0, 0, copy.width, copy.height).data;
+  let count = 0;
+  for (let i = 0; i < pixels.length; i += 4) {
+    count += Math.abs(pixels[i] - rgb[0]) <= 2 && Math.abs(pixels[i + 1] - rgb[1]) <= 2 &&
+             Math.abs(pixels[i + 2] - rgb[2]) <= 2;
+  }
+  return count;
+}, rgb);
+const settle = () => sleep(400);  // a change is drawn on the next animation frame
+
+// Held at the start, stepped, run, paused: the controls and the toggles.
+async function pauseStepAndToggles(page) {
   await page.waitForFunction(held, null, { timeout: 60000 });
   seen.start = Number((await data(page)).frame);
   await sleep(1500);
@@ -62,26 +81,7 @@ try {
     return drawn;
   });
   const display = (id) => page.evaluate((id) => getComputedStyle(document.getElementById(id)).display, id);
-  // 3D view: pixels of one colour (within 2 per channel) in the WebGL canvas. The lines are drawn
-  // in their exact colour (measured: the same count at 2 as at 24); a looser match also counted
-  // the odd blend of other layers (CI: 2 "green" pixels with the edges off).
-  const colourPixels = (rgb) => page.evaluate((rgb) => {
-    const gl = document.querySelector('#scene canvas');
-    const copy = document.createElement('canvas');
-    copy.width = gl.width;
-    copy.height = gl.height;
-    const g = copy.getContext('2d');
-    g.drawImage(gl, 0, 0);
-    const pixels = g.getImageData(0, 0, copy.width, copy.height).data;
-    let count = 0;
-    for (let i = 0; i < pixels.length; i += 4) {
-      count += Math.abs(pixels[i] - rgb[0]) <= 2 && Math.abs(pixels[i + 1] - rgb[1]) <= 2 &&
-               Math.abs(pixels[i + 2] - rgb[2]) <= 2;
-    }
-    return count;
-  }, rgb);
-  const covisPixels = () => colourPixels([0x3a, 0x9d, 0x54]);  // the edges' green
-  const settle = () => sleep(400);  // a change is drawn on the next animation frame
+  const covisPixels = () => colourPixels(page, [0x3a, 0x9d, 0x54]);  // the edges' green
   seen.marks_on = await marks();
   await page.click('#show-keypoints');
   await settle();
@@ -101,7 +101,7 @@ try {
   // The trajectory passes through every keyframe and is drawn after the edges: an edge between
   // two consecutive keyframes can lie entirely under it, so it is hidden while the edges are
   // counted (and counted itself: its orange goes and comes back).
-  const orange = () => colourPixels([0xe8, 0xa3, 0x3d]);
+  const orange = () => colourPixels(page, [0xe8, 0xa3, 0x3d]);
   seen.trajectory_on = await orange();
   await page.click('#show-trajectory');
   await settle();
@@ -143,6 +143,41 @@ try {
   await page.waitForFunction(`document.body.dataset.runState === 'finished'`, null,
                              { timeout: 300000 });
   seen.finished = true;
+}
+
+// Run to the end: the maps and merges the page lists once it shows the run's last map (the
+// last frame always sends the map; a merge is counted in the map it came with).
+async function watchAtlas(page) {
+  await page.waitForFunction(held, null, { timeout: 60000 });
+  await page.click('#resume');
+  const lastMapShown = `document.body.dataset.runState === 'finished' &&
+                        document.body.dataset.mapShown === document.body.dataset.mapVersion`;
+  await page.waitForFunction(lastMapShown, null, { timeout: 300000 });
+  // The last map may be published just after the run's end is announced: a second look.
+  await sleep(1000);
+  await page.waitForFunction(lastMapShown, null, { timeout: 60000 });
+  await settle();
+  const shown = await data(page);
+  seen.maps = Number(shown.maps);
+  seen.merges = Number(shown.merges);
+  seen.keyframes = Number(shown.keyframes);
+  seen.maps_listed = await page.evaluate(
+      () => [...document.querySelectorAll('#maps li')].map((item) => item.textContent));
+  seen.merges_listed = await page.evaluate(
+      () => [...document.querySelectorAll('#merges li')].map((item) => item.textContent));
+  // Frusta in the first two maps' colours (live.js MAP_COLOURS).
+  seen.map0_pixels = await colourPixels(page, [0x8a, 0xb4, 0xff]);
+  seen.map1_pixels = await colourPixels(page, [0xd6, 0x7c, 0xff]);
+  await page.screenshot({ path: screenshot });
+  seen.finished = true;
+}
+
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  page.on('pageerror', (error) => { seen.page_error = String(error); });
+  await page.goto(url);
+  if (check === 'atlas') await watchAtlas(page);
+  else await pauseStepAndToggles(page);
 } catch (error) {
   seen.error = String(error);
 } finally {

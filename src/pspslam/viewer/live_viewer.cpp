@@ -51,7 +51,9 @@ struct LiveViewer::FrameSnapshot {
 struct LiveViewer::MapSnapshot {
   std::vector<float> positions;  // x, y, z per static map point
   std::vector<Pose> keyframes;
-  std::vector<std::array<int, 2>> edges;  // covisibility, indices into keyframes
+  std::vector<std::uint32_t> keyframe_maps;  // the atlas map of each keyframe
+  std::vector<std::array<int, 2>> edges;     // covisibility, indices into keyframes
+  std::vector<MapMerge> merges;              // the atlas's merges so far, in order
   Trajectory estimate;
 };
 
@@ -192,8 +194,13 @@ void LiveViewer::frame_done(const FrameView& view) {
   std::unique_lock lock(mutex_);
   const bool detail = detail_;
   const bool show = detail || paused_;
-  const bool map_due = show && (paused_ || now - last_map_snapshot_ >= options_.map_interval ||
-                                view.mapping.keyframes_in_map != last_map_keyframes_);
+  // The last frame of a sequence always sends the map, so the page ends on the atlas the frames
+  // left (a new map or a merge just before the end would otherwise never be shown).
+  const bool last_frame = view.frames_total > 0 && view.frame.index + 1 == view.frames_total;
+  const bool map_due =
+      last_frame || (show && (paused_ || now - last_map_snapshot_ >= options_.map_interval ||
+                              view.mapping.keyframes_in_map != last_map_keyframes_ ||
+                              view.mapping.map_merges.size() != last_map_merges_));
   lock.unlock();
 
   // The copies, outside the lock: the encoder may be busy with the snapshot before.
@@ -209,6 +216,7 @@ void LiveViewer::frame_done(const FrameView& view) {
     pending_map_ = std::move(map);
     last_map_snapshot_ = now;
     last_map_keyframes_ = view.mapping.keyframes_in_map;
+    last_map_merges_ = view.mapping.map_merges.size();
   }
   work_.notify_one();
   // A pause that came while this frame was processed without its keypoint fates holds after the
@@ -272,6 +280,7 @@ std::unique_ptr<LiveViewer::MapSnapshot> LiveViewer::snapshot_map(const FrameVie
     if (keyframe->is_bad()) continue;
     index[keyframe->id()] = static_cast<int>(map->keyframes.size());
     map->keyframes.push_back(keyframe->T_world_camera());
+    map->keyframe_maps.push_back(keyframe->map_id());
   }
   for (const auto& keyframe : keyframes) {
     const auto from = index.find(keyframe->id());
@@ -282,6 +291,7 @@ std::unique_ptr<LiveViewer::MapSnapshot> LiveViewer::snapshot_map(const FrameVie
         map->edges.push_back({from->second, to->second});
     }
   }
+  map->merges = slam_map.merges();
   map->estimate = view.estimate;
   return map;
 }
@@ -515,10 +525,19 @@ void LiveViewer::publish_map(const MapSnapshot& s) {
     } catch (const Error&) {
     }
   }
+  json merges = json::array();
+  for (const MapMerge& merge : s.merges) {
+    merges.push_back({{"from", merge.from},
+                      {"into", merge.into},
+                      {"current_keyframe", merge.current_keyframe},
+                      {"matched_keyframe", merge.matched_keyframe}});
+  }
   auto text = share(json{
       {"positions", s.positions},
       {"keyframes", std::move(keyframes)},
+      {"keyframe_maps", s.keyframe_maps},
       {"edges", s.edges},
+      {"merges", std::move(merges)},
       {"trajectory", std::move(trajectory)},
       {"truth", std::move(truth)},
       {"ate_rmse",

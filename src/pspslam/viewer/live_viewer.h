@@ -107,6 +107,7 @@ class LiveViewer final : public RunObserver {
   Clock::time_point last_frame_snapshot_{};
   Clock::time_point last_map_snapshot_{};
   std::uint64_t last_map_keyframes_ = 0;
+  size_t last_map_merges_ = 0;
   // Published (read by the server threads; replaced, never modified, so a reply shares them).
   std::uint64_t event_ = 0;  // any change: frame, map or state
   std::uint64_t frame_version_ = 0;

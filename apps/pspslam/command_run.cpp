@@ -15,6 +15,8 @@
 //   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,
 //                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)
+#include <spdlog/fmt/fmt.h>
+
 #include <opencv2/core/utility.hpp>
 
 #include <chrono>
@@ -121,7 +123,7 @@ struct RunFlags {
   std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
   std::string vocabulary;            // empty: the shipped vocabulary
   bool no_relocalization = false;
-  double new_map_after = kNewMapAfterSeconds;
+  double new_map_after = -1.0;  // -1: kNewMapAfterSeconds, kLiveNewMapAfterSeconds for live runs
   std::string loop_closing = "auto";
   std::string save_map;
   std::string load_map;
@@ -156,7 +158,7 @@ RunSettings run_settings(const RunFlags& flags) {
   settings.live_camera = !flags.camera.empty();
   settings.local_mapping = !flags.no_local_mapping;
   settings.relocalization = !flags.no_relocalization;
-  settings.new_map_after = flags.new_map_after;
+  if (flags.new_map_after >= 0.0) settings.new_map_after = flags.new_map_after;
   settings.loop_closing = flags.loop_closing;
   settings.mask_margin = flags.mask_margin;
   settings.segment_every = flags.segment_every;
@@ -513,9 +515,11 @@ void add_map_options(CLI::App* app, RunFlags& flags) {
   app->add_option("--new-map-after", flags.new_map_after,
                   "SECONDS lost, with relocalisation failing in every map, before tracking starts "
                   "a new map in the atlas; loop closing merges it when a place is recognised "
-                  "across the two (0: never; the run stays lost until relocalised)")
-      ->check(in_range(0.0, 3600.0))
-      ->capture_default_str();
+                  "across the two (0: never; the run stays lost until relocalised; default: " +
+                      fmt::format("{:g} s, {:g} s for live runs", kNewMapAfterSeconds,
+                                  kLiveNewMapAfterSeconds) +
+                      ")")
+      ->check(in_range(0.0, 3600.0));
   app->add_option("--loop-closing", flags.loop_closing,
                   "loop closing thread (detection, essential-graph correction, global BA); auto = "
                   "on when the vocabulary file exists")

@@ -43,7 +43,7 @@ void check_ranges(const RunSettings& settings) {
   require_range(settings.segment_every, 1, 30, "segment_every");
   require_range(settings.cull_hits, 1, 1000, "cull_hits");
   require_range(settings.keyframe_ratio, 0.01, 1.0, "keyframe_ratio");
-  require_range(settings.new_map_after, 0.0, 3600.0, "new_map_after");
+  if (settings.new_map_after) require_range(*settings.new_map_after, 0.0, 3600.0, "new_map_after");
   if (settings.local_ba_keyframes)
     require_range(*settings.local_ba_keyframes, 0, 1000, "local_ba_keyframes");
   if (settings.background_nice) require_range(*settings.background_nice, 0, 19, "background_nice");

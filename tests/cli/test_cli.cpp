@@ -924,9 +924,10 @@ TEST(CliRun, MonocularFramesBeforeTheMapStartArePlacedInIt) {
 // frame 300 the camera sees the start again. Per sensor:
 // - two sessions: the first maps frames 0-149 and saves the map; the second loads it and starts at
 //   frame 220, which the first never saw. Relocalisation fails for a second, a new map starts,
-//   and it merges into the loaded one when the camera reaches its area. The merged trajectory is
-//   in the loaded map's frame, as accurate as a single session over the same frames (measured:
-//   RGB-D 3.7 against 6.8 mm, monocular 4.9 against 6.0 mm);
+//   places the frames of that second (RGB-D: 228 of 230 with a pose; monocular: 208), and merges
+//   into the loaded one when the camera reaches its area. The merged trajectory is in the loaded
+//   map's frame, as accurate as a single session over the same frames (measured: RGB-D 4.2
+//   against 6.8 mm, monocular 4.9 against 6.0 mm);
 // - one session with frames 150-219 black: relocalisation gives up, a second map starts at frame
 //   220 and merges back (RGB-D 10.7 mm, monocular 6.9 mm over the 380 frames with a pose).
 TEST(CliRun, AtlasStartsNewMapsThatMergeWhenTheCameraReturns) {
@@ -960,8 +961,9 @@ TEST(CliRun, AtlasStartsNewMapsThatMergeWhenTheCameraReturns) {
     EXPECT_EQ(second["atlas"]["merges"][0]["into"], 0);
     EXPECT_EQ(second["atlas"]["maps_at_end"], nlohmann::json({0}));
     EXPECT_EQ(second["atlas"]["other_map_poses"], 0);
-    // The frames without a pose are those of the second spent relocalising before the new map.
-    EXPECT_LE(second["lost_frames"].get<int>(), 30);
+    // The frames without a pose are those of the second spent relocalising before the new map
+    // that it could not place.
+    EXPECT_LE(second["lost_frames"].get<int>(), sensor == "monocular" ? 30 : 5);
     EXPECT_EQ(second["atlas"]["main_map_poses"].get<int>() + second["lost_frames"].get<int>(), 230);
     r = pspslam(run + out("single").string() + " --start-frame 220");
     ASSERT_EQ(r.status, 0) << r.output;

@@ -30,7 +30,8 @@ bool wants_loop_closing(const std::string& value, const std::filesystem::path& v
 void set_tracking(const RunSettings& settings, SystemOptions& system) {
   system.tracker.keyframes.tracked_ratio_to_reference = settings.keyframe_ratio;
   system.tracker.keyframes.insert_when_due = settings.due_keyframes;
-  system.tracker.new_map_after_seconds = settings.new_map_after;
+  system.tracker.new_map_after_seconds = settings.new_map_after.value_or(
+      settings.live() ? kLiveNewMapAfterSeconds : kNewMapAfterSeconds);
   if (settings.motion_prior) {
     system.tracker.motion_prior_sigma_translation = settings.motion_prior->first * 1e-3;
     system.tracker.motion_prior_sigma_rotation =

@@ -18,8 +18,12 @@ inline constexpr int kLiveBackgroundNice = 10;
 // ORB-SLAM2's whole window, which gives the better final trajectory.
 inline constexpr int kLiveLocalBaKeyframes = 10;
 // The atlas: seconds lost, with every relocalisation failing, before a new map starts
-// (TrackerOptions::new_map_after_seconds).
+// (TrackerOptions::new_map_after_seconds). A live run waits longer: while the network lags, the
+// crowd can keep tracking lost for over a second before relocalisation finds the map again, and a
+// new map started meanwhile leaves the frames after it in another world frame until a merge
+// (docs/decisions/atlas.md).
 inline constexpr double kNewMapAfterSeconds = 1.0;
+inline constexpr double kLiveNewMapAfterSeconds = 3.0;
 
 // The run settings that shape the System: `pspslam run`'s flags and the Python module's keywords
 // of the same names, with their defaults. Empty optionals take the run's default.
@@ -34,8 +38,9 @@ struct RunSettings {
   bool live_camera = false;  // frames from a live camera: live as with realtime
   bool local_mapping = true;
   bool relocalization = true;
-  double new_map_after = kNewMapAfterSeconds;  // 0: never start a new map
-  std::string loop_closing = "auto";           // on | off | auto
+  // 0: never start a new map; none: kLiveNewMapAfterSeconds when live, else kNewMapAfterSeconds.
+  std::optional<double> new_map_after;
+  std::string loop_closing = "auto";  // on | off | auto
   int mask_margin = 5;
   int segment_every = 1;
   int cull_hits = 3;

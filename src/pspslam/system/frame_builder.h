@@ -61,7 +61,7 @@ class FrameBuilder {
   // How the map starts: one frame with depth (RGB-D, stereo) or two views (monocular).
   virtual std::unique_ptr<MapInitializer> make_map_initializer(
       const TrackerOptions& options) const {
-    return make_depth_map_initializer(options.min_initial_depth_points);
+    return make_depth_map_initializer(options.min_initial_depth_points, options.pose_optimizer);
   }
   // Local mapping rules that depend on depth readings.
   virtual void adapt(LocalMappingOptions&) const {}

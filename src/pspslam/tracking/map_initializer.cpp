@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <deque>
 #include <optional>
 
 #include "pspslam/map/descriptor.h"
@@ -11,6 +12,7 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/match/orb_matcher.h"
 #include "pspslam/optimize/global_bundle_adjustment.h"
+#include "pspslam/solve/pnp_ransac.h"
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 
@@ -19,7 +21,8 @@ namespace {
 
 class DepthMapInitializer final : public MapInitializer {
  public:
-  explicit DepthMapInitializer(int min_points) : min_points_(min_points) {}
+  DepthMapInitializer(int min_points, PoseOptimizerOptions pose_optimizer)
+      : min_points_(min_points), pose_optimizer_(std::move(pose_optimizer)) {}
 
   std::vector<std::shared_ptr<KeyFrame>> initialize(Frame& frame, Map& map,
                                                     InitializationProgress& progress) override {
@@ -30,11 +33,70 @@ class DepthMapInitializer final : public MapInitializer {
     if (with_depth < min_points_) return {};
     // The first camera defines the world frame.
     frame.set_pose(Pose::Identity());
-    return {create_keyframe(frame, map, /*initial=*/true)};
+    const std::shared_ptr<KeyFrame> first = create_keyframe(frame, map, /*initial=*/true);
+    place_lost_frames(*first);
+    return {first};
+  }
+
+  // The newest lost frames are kept, without what tracking matched them to in the old map.
+  void observe(const Frame& frame) override {
+    if (lost_.size() == kMaxKeptFrames) lost_.pop_front();
+    Frame& kept = lost_.emplace_back(frame);
+    kept.clear_pose();
+    std::fill(kept.map_points.begin(), kept.map_points.end(), nullptr);
+    std::fill(kept.outlier.begin(), kept.outlier.end(), 0);
+  }
+
+  std::vector<EarlierFramePose> take_earlier_frames() override { return std::move(earlier_); }
+
+  void reset() override {
+    lost_.clear();
+    earlier_.clear();
   }
 
  private:
+  // 3 s at 30 fps, as the monocular start keeps (MonocularInitializerOptions::max_earlier_frames).
+  static constexpr size_t kMaxKeptFrames = 90;
+  // Tracking's minimum of local-map inliers (TrackerOptions::min_local_map_inliers).
+  static constexpr int kMinInliers = 30;
+
+  // A new map of the atlas starts with the frames lost before it still kept (observe): each is
+  // placed on the first keyframe's points as tracking recovers a lost frame (brute-force matches,
+  // PnP-RANSAC, pose-only optimisation). One that keeps too few inliers (black, or looking
+  // elsewhere) stays without a pose.
+  void place_lost_frames(const KeyFrame& first) {
+    earlier_.clear();
+    MatcherOptions matcher;
+    matcher.nn_ratio = 0.7;  // nothing constrains where a match may be: the recovery's ratio
+    for (Frame& lost : lost_) {
+      if (search_keyframe_brute_force(lost, first, matcher) < kMinInliers) continue;
+      std::vector<Eigen::Vector3d> points;
+      std::vector<Eigen::Vector2d> pixels;
+      std::vector<int> keypoint;
+      for (int i = 0; i < lost.size(); ++i) {
+        if (!lost.map_points[i]) continue;
+        points.push_back(lost.map_points[i]->position());
+        pixels.emplace_back(lost.keypoints()[i].pt.x, lost.keypoints()[i].pt.y);
+        keypoint.push_back(i);
+      }
+      const PnpRansacResult pnp = solve_pnp_ransac(lost.camera().pinhole, points, pixels);
+      if (!pnp.success) continue;
+      for (size_t k = 0; k < keypoint.size(); ++k) {
+        if (!pnp.inlier[k]) lost.map_points[keypoint[k]] = nullptr;
+      }
+      lost.set_pose(pnp.T_camera_world);
+      if (optimize_frame_pose(lost, pose_optimizer_, pose_buffers_).num_inliers < kMinInliers)
+        continue;
+      earlier_.push_back({lost.timestamp(), lost.T_camera_world(), /*is_first_keyframe=*/false});
+    }
+    lost_.clear();
+  }
+
   int min_points_;
+  PoseOptimizerOptions pose_optimizer_;
+  std::deque<Frame> lost_;                 // oldest first
+  std::vector<EarlierFramePose> earlier_;  // placed by the last start, oldest first
+  FramePoseBuffers pose_buffers_;
 };
 
 class MonocularMapInitializer final : public MapInitializer {
@@ -308,8 +370,9 @@ class MonocularMapInitializer final : public MapInitializer {
 
 }  // namespace
 
-std::unique_ptr<MapInitializer> make_depth_map_initializer(int min_points) {
-  return std::make_unique<DepthMapInitializer>(min_points);
+std::unique_ptr<MapInitializer> make_depth_map_initializer(int min_points,
+                                                           PoseOptimizerOptions pose_optimizer) {
+  return std::make_unique<DepthMapInitializer>(min_points, std::move(pose_optimizer));
 }
 
 std::unique_ptr<MapInitializer> make_monocular_map_initializer(

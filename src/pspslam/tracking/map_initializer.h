@@ -45,9 +45,9 @@ class MapInitializer {
   virtual std::vector<std::shared_ptr<KeyFrame>> initialize(Frame& frame, Map& map,
                                                             InitializationProgress& progress) = 0;
 
-  // A lost frame before a new map may start (TrackerOptions::new_map_after_seconds): kept as
-  // initialize() would keep a frame that cannot start the map yet, so that the map, once
-  // started, can place it (monocular). Does nothing by default.
+  // A lost frame before a new map may start (TrackerOptions::new_map_after_seconds), kept so
+  // that the map, once started, can place it: monocular as a frame between its two views,
+  // depth on its first keyframe. Does nothing by default.
   virtual void observe(const Frame& /*frame*/) {}
 
   // After a successful initialize(): the frames before `frame` that the new map can place, oldest
@@ -61,8 +61,10 @@ class MapInitializer {
   virtual void reset() {}
 };
 
-// One frame with at least `min_points` keypoints with depth starts the map (RGB-D, stereo).
-std::unique_ptr<MapInitializer> make_depth_map_initializer(int min_points);
+// One frame with at least `min_points` keypoints with depth starts the map (RGB-D, stereo). A new
+// map of the atlas also places the lost frames it was shown (observe) on its first keyframe.
+std::unique_ptr<MapInitializer> make_depth_map_initializer(
+    int min_points, PoseOptimizerOptions pose_optimizer = {});
 
 struct MonocularInitializerOptions {
   int min_keypoints = 100;           // a frame with fewer cannot start the map

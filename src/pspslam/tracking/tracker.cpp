@@ -52,7 +52,8 @@ Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
       mover_guard_(options_.mover_guard),
       local_map_(options_.max_local_keyframes),
       initializer_(initializer ? std::move(initializer)
-                               : make_depth_map_initializer(options_.min_initial_depth_points)) {
+                               : make_depth_map_initializer(options_.min_initial_depth_points,
+                                                            options_.pose_optimizer)) {
   if (place)
     relocalizer_ = std::make_unique<Relocalizer>(map_, std::move(place), options_.relocalizer);
 }
@@ -161,7 +162,7 @@ void Tracker::on_lost(Frame& frame, TrackResult& result) {
     initializer_->reset();
   }
   if (!young && frame.timestamp() - *lost_since_ < options_.new_map_after_seconds) {
-    initializer_->observe(frame);  // a monocular start can place the frames lost meanwhile
+    initializer_->observe(frame);  // the new map's start can place the frames lost meanwhile
     return;
   }
   // A new map in the atlas; the frames tracked so far stay in theirs, and the frames the

@@ -116,7 +116,7 @@ void LoopClosing::close_loop(const DetectedLoop& loop) {
   detector_.loop_closed_at(loop.current->id());
   {
     std::lock_guard lock(mutex_);
-    ++(report.merge ? stats_.maps_merged : stats_.loops_closed);
+    if (!report.merge) ++stats_.loops_closed;
     stats_.last_correction = report;
   }
   // On the map the loop closed (after a merge: the merged one); other maps are not touched.

@@ -56,8 +56,7 @@ void close_loops_with_scale(LoopClosingOptions& options);
 
 struct LoopClosingStats {
   LoopDetectorStats detector;
-  std::uint64_t loops_closed = 0;
-  std::uint64_t maps_merged = 0;  // places recognised across two maps of the atlas
+  std::uint64_t loops_closed = 0;  // within one map (merges: Map::merges)
   std::uint64_t global_ba_started = 0;
   std::uint64_t global_ba_applied = 0;
   std::uint64_t global_ba_aborted = 0;

@@ -169,7 +169,6 @@ void Tracker::on_lost(Frame& frame, TrackResult& result) {
   // initialiser kept since the loss wait for it.
   forget_tracking_state(/*keep_initializer=*/true);
   ++map_epoch_;  // the new map has its own world frame: no correction is interpolated across
-  ++new_maps_;
   map_.open_new_map();
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   std::fill(frame.outlier.begin(), frame.outlier.end(), 0);

@@ -175,8 +175,6 @@ class Tracker {
   // out of refined_trajectory(), since the new map has its own world frame (and scale).
   void restart();
   int restarts() const { return restarts_; }
-  // Maps started after the first (TrackerOptions::new_map_after_seconds).
-  int new_maps() const { return new_maps_; }
 
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
@@ -238,7 +236,6 @@ class Tracker {
   std::unique_ptr<Relocalizer> relocalizer_;  // null without a vocabulary
   std::unique_ptr<MapInitializer> initializer_;
   int restarts_ = 0;
-  int new_maps_ = 0;
   std::optional<Timestamp> lost_since_;  // the first frame of the current loss
   bool opening_new_map_ = false;         // a map beyond the first is starting
 

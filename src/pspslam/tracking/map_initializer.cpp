@@ -19,6 +19,47 @@
 namespace pspslam {
 namespace {
 
+// Tracking's minimum of local-map inliers (TrackerOptions::min_local_map_inliers).
+constexpr int kMinPlacedInliers = 30;
+// Lost frames kept for a new map: 3 s at 30 fps (MonocularInitializerOptions::max_earlier_frames).
+constexpr size_t kMaxKeptLostFrames = 90;
+
+// A lost frame placed on a new map's keyframe as tracking recovers a lost frame: brute-force
+// matches with the keyframe's points, PnP-RANSAC, pose-only optimisation. False when too few
+// inliers remain (black, or looking elsewhere).
+bool place_on_keyframe(Frame& lost, const KeyFrame& keyframe,
+                       const PoseOptimizerOptions& pose_optimizer, FramePoseBuffers& buffers) {
+  MatcherOptions matcher;
+  matcher.nn_ratio = 0.7;  // nothing constrains where a match may be: the recovery's ratio
+  std::fill(lost.map_points.begin(), lost.map_points.end(), nullptr);
+  if (search_keyframe_brute_force(lost, keyframe, matcher) < kMinPlacedInliers) return false;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<int> keypoint;
+  for (int i = 0; i < lost.size(); ++i) {
+    if (!lost.map_points[i]) continue;
+    points.push_back(lost.map_points[i]->position());
+    pixels.emplace_back(lost.keypoints()[i].pt.x, lost.keypoints()[i].pt.y);
+    keypoint.push_back(i);
+  }
+  const PnpRansacResult pnp = solve_pnp_ransac(lost.camera().pinhole, points, pixels);
+  if (!pnp.success) return false;
+  for (size_t k = 0; k < keypoint.size(); ++k) {
+    if (!pnp.inlier[k]) lost.map_points[keypoint[k]] = nullptr;
+  }
+  lost.set_pose(pnp.T_camera_world);
+  return optimize_frame_pose(lost, pose_optimizer, buffers).num_inliers >= kMinPlacedInliers;
+}
+
+// A lost frame as kept for a new map: without what tracking matched it to in the old map.
+void keep_lost_frame(const Frame& frame, std::deque<Frame>& kept) {
+  if (kept.size() == kMaxKeptLostFrames) kept.pop_front();
+  Frame& copy = kept.emplace_back(frame);
+  copy.clear_pose();
+  std::fill(copy.map_points.begin(), copy.map_points.end(), nullptr);
+  std::fill(copy.outlier.begin(), copy.outlier.end(), 0);
+}
+
 class DepthMapInitializer final : public MapInitializer {
  public:
   DepthMapInitializer(int min_points, PoseOptimizerOptions pose_optimizer)
@@ -38,14 +79,7 @@ class DepthMapInitializer final : public MapInitializer {
     return {first};
   }
 
-  // The newest lost frames are kept, without what tracking matched them to in the old map.
-  void observe(const Frame& frame) override {
-    if (lost_.size() == kMaxKeptFrames) lost_.pop_front();
-    Frame& kept = lost_.emplace_back(frame);
-    kept.clear_pose();
-    std::fill(kept.map_points.begin(), kept.map_points.end(), nullptr);
-    std::fill(kept.outlier.begin(), kept.outlier.end(), 0);
-  }
+  void observe(const Frame& frame) override { keep_lost_frame(frame, lost_); }
 
   std::vector<EarlierFramePose> take_earlier_frames() override { return std::move(earlier_); }
 
@@ -55,39 +89,13 @@ class DepthMapInitializer final : public MapInitializer {
   }
 
  private:
-  // 3 s at 30 fps, as the monocular start keeps (MonocularInitializerOptions::max_earlier_frames).
-  static constexpr size_t kMaxKeptFrames = 90;
-  // Tracking's minimum of local-map inliers (TrackerOptions::min_local_map_inliers).
-  static constexpr int kMinInliers = 30;
-
-  // A new map of the atlas starts with the frames lost before it still kept (observe): each is
-  // placed on the first keyframe's points as tracking recovers a lost frame (brute-force matches,
-  // PnP-RANSAC, pose-only optimisation). One that keeps too few inliers (black, or looking
-  // elsewhere) stays without a pose.
+  // A new map of the atlas starts with the frames lost before it still kept (observe), each
+  // placed on its first keyframe.
   void place_lost_frames(const KeyFrame& first) {
     earlier_.clear();
-    MatcherOptions matcher;
-    matcher.nn_ratio = 0.7;  // nothing constrains where a match may be: the recovery's ratio
     for (Frame& lost : lost_) {
-      if (search_keyframe_brute_force(lost, first, matcher) < kMinInliers) continue;
-      std::vector<Eigen::Vector3d> points;
-      std::vector<Eigen::Vector2d> pixels;
-      std::vector<int> keypoint;
-      for (int i = 0; i < lost.size(); ++i) {
-        if (!lost.map_points[i]) continue;
-        points.push_back(lost.map_points[i]->position());
-        pixels.emplace_back(lost.keypoints()[i].pt.x, lost.keypoints()[i].pt.y);
-        keypoint.push_back(i);
-      }
-      const PnpRansacResult pnp = solve_pnp_ransac(lost.camera().pinhole, points, pixels);
-      if (!pnp.success) continue;
-      for (size_t k = 0; k < keypoint.size(); ++k) {
-        if (!pnp.inlier[k]) lost.map_points[keypoint[k]] = nullptr;
-      }
-      lost.set_pose(pnp.T_camera_world);
-      if (optimize_frame_pose(lost, pose_optimizer_, pose_buffers_).num_inliers < kMinInliers)
-        continue;
-      earlier_.push_back({lost.timestamp(), lost.T_camera_world(), /*is_first_keyframe=*/false});
+      if (place_on_keyframe(lost, first, pose_optimizer_, pose_buffers_))
+        earlier_.push_back({lost.timestamp(), lost.T_camera_world(), /*is_first_keyframe=*/false});
     }
     lost_.clear();
   }
@@ -152,6 +160,7 @@ class MonocularMapInitializer final : public MapInitializer {
       take_as_reference(frame);
     } else {
       localise_between(*keyframes.front());
+      place_lost_frames(*keyframes.front());
       reference_.reset();
     }
     return keyframes;
@@ -159,8 +168,12 @@ class MonocularMapInitializer final : public MapInitializer {
 
   void observe(const Frame& frame) override {
     if (frame.size() < options_.min_keypoints) {
-      reset();
-    } else if (!reference_ || match_with_reference(frame) < options_.min_matches) {
+      reference_.reset();
+      between_.clear();
+      return;
+    }
+    keep_lost_frame(frame, lost_);
+    if (!reference_ || match_with_reference(frame) < options_.min_matches) {
       take_as_reference(frame);
     } else {
       remember_between(frame);
@@ -174,6 +187,7 @@ class MonocularMapInitializer final : public MapInitializer {
     reference_.reset();
     between_.clear();
     earlier_.clear();
+    lost_.clear();
   }
 
  private:
@@ -218,6 +232,21 @@ class MonocularMapInitializer final : public MapInitializer {
       earlier_.push_back({frame.timestamp(), previous, /*is_first_keyframe=*/false});
     }
     between_.clear();
+  }
+
+  // A new map of the atlas: the frames lost before its reference view (a fast turn makes the
+  // start take new references, and the frames before the last one are not between its views),
+  // each placed on the first keyframe's points.
+  void place_lost_frames(const KeyFrame& first) {
+    const Timestamp reference_time = earlier_.front().timestamp;
+    for (Frame& lost : lost_) {
+      if (lost.timestamp() >= reference_time) break;
+      if (place_on_keyframe(lost, first, options_.pose_optimizer, pose_buffers_))
+        earlier_.push_back({lost.timestamp(), lost.T_camera_world(), /*is_first_keyframe=*/false});
+    }
+    lost_.clear();
+    std::sort(earlier_.begin(), earlier_.end(),
+              [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
   }
 
   void take_as_reference(const Frame& frame) {
@@ -356,6 +385,7 @@ class MonocularMapInitializer final : public MapInitializer {
   std::optional<Frame> reference_;
   std::vector<FrameBetween> between_;      // matched with reference_ since it was taken
   std::vector<EarlierFramePose> earlier_;  // placed by the last successful start
+  std::deque<Frame> lost_;                 // a new map's lost frames so far (observe), oldest first
   FramePoseBuffers pose_buffers_;
   std::vector<cv::Point2f> last_position_;  // per reference keypoint
   // Per-attempt buffers, reused.

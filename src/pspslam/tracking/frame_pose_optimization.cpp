@@ -4,6 +4,7 @@
 #include "pspslam/map/frame.h"
 #include "pspslam/map/map_point.h"
 #include "pspslam/optimize/rolling_shutter_pose.h"
+#include "pspslam/solve/pnp_ransac.h"
 
 namespace pspslam {
 namespace {
@@ -65,6 +66,25 @@ PoseInformation frame_pose_information(const Frame& frame, const PoseOptimizerOp
   gather_observations(frame, /*inliers_only=*/true, buffers);
   return pose_information(frame.camera().pinhole, frame.camera().bf, options.depth_noise,
                           frame.T_camera_world(), buffers.observations, prior);
+}
+
+bool pose_from_matches(Frame& frame) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<int> keypoint;
+  for (int i = 0; i < frame.size(); ++i) {
+    if (!frame.map_points[i]) continue;
+    points.push_back(frame.map_points[i]->position());
+    pixels.emplace_back(frame.keypoints()[i].pt.x, frame.keypoints()[i].pt.y);
+    keypoint.push_back(i);
+  }
+  const PnpRansacResult pnp = solve_pnp_ransac(frame.camera().pinhole, points, pixels);
+  if (!pnp.success) return false;
+  for (size_t k = 0; k < keypoint.size(); ++k) {
+    if (!pnp.inlier[k]) frame.map_points[keypoint[k]] = nullptr;
+  }
+  frame.set_pose(pnp.T_camera_world);
+  return true;
 }
 
 }  // namespace pspslam

@@ -31,6 +31,11 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
                                            FramePoseBuffers& buffers,
                                            const PosePrior* prior = nullptr);
 
+// The frame's pose from its map point matches alone (PnP-RANSAC), for a frame whose last pose is
+// stale or unknown (recovery, a lost frame placed in a new map): set on the frame, the matches
+// outside the consensus dropped. False, the frame unchanged, when it fails.
+bool pose_from_matches(Frame& frame);
+
 // Rolling shutter (CameraModel::rolling_shutter_readout_s != 0): the pose and the rotation rate of
 // `frame` refined together on its inlier matches (optimize/rolling_shutter_pose.h, prior
 // `sigma_rate` rad/s), the pose set and the keypoints moved by the rate correction, which is

@@ -12,7 +12,6 @@
 #include "pspslam/map/map_point.h"
 #include "pspslam/match/orb_matcher.h"
 #include "pspslam/optimize/global_bundle_adjustment.h"
-#include "pspslam/solve/pnp_ransac.h"
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 
@@ -33,21 +32,7 @@ bool place_on_keyframe(Frame& lost, const KeyFrame& keyframe,
   matcher.nn_ratio = 0.7;  // nothing constrains where a match may be: the recovery's ratio
   std::fill(lost.map_points.begin(), lost.map_points.end(), nullptr);
   if (search_keyframe_brute_force(lost, keyframe, matcher) < kMinPlacedInliers) return false;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<int> keypoint;
-  for (int i = 0; i < lost.size(); ++i) {
-    if (!lost.map_points[i]) continue;
-    points.push_back(lost.map_points[i]->position());
-    pixels.emplace_back(lost.keypoints()[i].pt.x, lost.keypoints()[i].pt.y);
-    keypoint.push_back(i);
-  }
-  const PnpRansacResult pnp = solve_pnp_ransac(lost.camera().pinhole, points, pixels);
-  if (!pnp.success) return false;
-  for (size_t k = 0; k < keypoint.size(); ++k) {
-    if (!pnp.inlier[k]) lost.map_points[keypoint[k]] = nullptr;
-  }
-  lost.set_pose(pnp.T_camera_world);
+  if (!pose_from_matches(lost)) return false;
   return optimize_frame_pose(lost, pose_optimizer, buffers).num_inliers >= kMinPlacedInliers;
 }
 

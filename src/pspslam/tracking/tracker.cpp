@@ -6,7 +6,6 @@
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
-#include "pspslam/solve/pnp_ransac.h"
 #include "pspslam/tracking/frame_pose_optimization.h"
 #include "pspslam/tracking/keyframe_builder.h"
 #include "pspslam/tracking/keyframe_sink.h"
@@ -395,26 +394,12 @@ bool Tracker::track_reference_keyframe(Frame& frame, bool recovering) {
   const int matches = search_keyframe_brute_force(frame, *reference_keyframe_, matcher);
   if (matches < options_.min_reference_matches) return false;
 
-  Pose initial = *last_tracked_pose_;
+  // After a loss the last pose may be stale: estimate one from the matches alone.
   if (recovering) {
-    // The last pose may be stale: estimate one from the matches alone.
-    std::vector<Eigen::Vector3d> points;
-    std::vector<Eigen::Vector2d> pixels;
-    std::vector<int> keypoint;
-    for (int i = 0; i < frame.size(); ++i) {
-      if (!frame.map_points[i]) continue;
-      points.push_back(frame.map_points[i]->position());
-      pixels.emplace_back(frame.keypoints()[i].pt.x, frame.keypoints()[i].pt.y);
-      keypoint.push_back(i);
-    }
-    const PnpRansacResult pnp = solve_pnp_ransac(frame.camera().pinhole, points, pixels);
-    if (!pnp.success) return false;
-    initial = pnp.T_camera_world;
-    for (size_t k = 0; k < keypoint.size(); ++k) {
-      if (!pnp.inlier[k]) frame.map_points[keypoint[k]] = nullptr;
-    }
+    if (!pose_from_matches(frame)) return false;
+  } else {
+    frame.set_pose(*last_tracked_pose_);
   }
-  frame.set_pose(initial);
   optimize_frame_pose(frame);
   return discard_outliers(frame) >= options_.min_pose_inliers;
 }

@@ -214,6 +214,9 @@ def expand(experiment, setup, prepared):
                 job = make_job(experiment, cell, variant, ready, repeat, setup, cli, cli_sha256)
                 job["slot"] = (cell.name, variant.name, repeat)
                 jobs.append(job)
+    # Repeat by repeat: each round runs every variant once, so a machine that drifts during an
+    # invocation (a neighbour, the clock) moves all variants alike and the pairing stays fair.
+    jobs.sort(key=lambda job: job["slot"][2])
     return table, jobs
 
 

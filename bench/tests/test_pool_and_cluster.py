@@ -180,3 +180,17 @@ def test_killed_pool_process_still_leaves_a_complete_table(local_tables, tmp_pat
     assert section_tables(results, "tiny") == local_tables["tables"]
     finished = [line.split()[0] for line in executed_runs(work)]
     assert len(finished) == len(set(finished)) == RUNS
+
+
+def test_runs_are_ordered_round_by_round(local_tables, tmp_path, build):
+    """Each round runs every variant once, so that a machine drifting during an invocation moves
+    all variants alike: the dry run lists the runs in the order they are executed."""
+    experiment = tmp_path / "rounds.toml"
+    experiment.write_text(local_tables["experiment"].read_text().replace(
+        'base = "off"\n', 'base = "off"\nrepeats = 2\n'))
+    completed = run_runner(experiment, "--work", fresh_work(local_tables, tmp_path),
+                           "--results", tmp_path / "results.md", "--dry-run", build=build)
+    labels = [line.split("  ")[1] for line in completed.stdout.splitlines()
+              if line.startswith("to run")]
+    assert labels == [f"tiny_s{seed} · {mode} · run {repeat}"
+                      for repeat in (1, 2) for seed in (1, 2) for mode in ("off", "geometry")]

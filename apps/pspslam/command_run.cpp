@@ -113,6 +113,7 @@ struct RunFlags {
   int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
   std::string mover_guard = "off";
   std::string stale_geometry = "on";
+  std::string late_mask_culling = "on";
   std::string semantic_delay;  // empty: none (fault injection)
   std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
@@ -186,6 +187,7 @@ void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
     dynamic.smaller_model = shipped_smaller;
   system.tracker.mover_guard.enabled = flags.mover_guard == "on";
   dynamic.tighten_geometry = flags.stale_geometry == "on";
+  dynamic.cull_with_late_masks = flags.late_mask_culling == "on";
   dynamic.propagation.max_growth_px = flags.stale_mask_growth;
   dynamic.stale_masks =
       flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
@@ -421,6 +423,12 @@ void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
   app->add_option("--stale-geometry", flags.stale_geometry,
                   "with --realtime and --stale-masks flow: while the mask is more than 2 frames "
                   "old, every keypoint in a band around it gets the multi-view geometry test")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--late-mask-culling", flags.late_mask_culling,
+                  "with --realtime: a mask that arrives after its frame was tracked still judges "
+                  "that frame; map points the frame saw on its people count towards their "
+                  "culling")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   app->add_option("--mover-guard", flags.mover_guard,

@@ -686,6 +686,15 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   EXPECT_EQ(masks["stale_after_frames"].get<int>(), 2);
   EXPECT_EQ(masks["stale_masks"].get<std::string>(), "homography");
   EXPECT_LE(masks["frames_on_stale_mask"].get<int>(), stats["frames"].get<int>());
+  // A live run's mask always arrives after its frame was tracked (a frame is announced when it
+  // begins), so each frame a used mask was made for is judged when it arrives.
+  EXPECT_TRUE(masks["cull_with_late_masks"].get<bool>());
+  EXPECT_TRUE(contains(live.output, "culling by exact masks only: on (")) << live.output;
+  ASSERT_GT(stats["mask_latency"]["frames"]["count"].get<int>(), 0) << live.output;
+  EXPECT_GT(masks["late_frames_judged"].get<int>(), 0) << live.output;
+  EXPECT_LE(masks["late_frames_judged"].get<int>(), stats["frames"].get<int>());
+  EXPECT_LE(masks["culled_by_late_masks"].get<int>(),
+            stats["dynamic"]["culled_map_points"].get<int>());
   const nlohmann::json& levels = masks["pace"]["levels"];
   ASSERT_EQ(levels.size(), 4u);
   EXPECT_EQ(levels[1]["network"].get<std::string>(), "pspnet_288x192.yaml (288x192)");

@@ -230,6 +230,7 @@ void DynamicPipeline::reanchor_last_pose(const std::optional<Pose>& T_world_came
 void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
                                 const cv::Mat& semantic_mask, DynamicReport& report) {
   previous_mask_ = fuse_dynamic_masks(semantic_mask, geometry_mask_, 0);
+  remember_segmented_frame(result, depth, report);
   if (result.keyframe_inserted && geometry_) {
     if (auto keyframe = map_.keyframe(map_.max_keyframe_id())) {
       // The depth Mat is shared, not copied: frames are loaded fresh and never written to.
@@ -251,9 +252,8 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     }
     last_pose_ = result.T_world_camera;
     last_pose_id_ = current_id_;
-    if (!previous_mask_.empty() && !protect_map_) {
-      const cv::Mat cull_mask =
-          cull_mask_.empty() ? previous_mask_ : fuse_dynamic_masks(cull_mask_, geometry_mask_, 0);
+    const cv::Mat cull_mask = culling_mask(report);
+    if (!cull_mask.empty() && !protect_map_) {
       const auto points = map_.reference_map_points();
       const auto& culled =
           culler_.observe(points, *result.T_world_camera, cull_mask, depth, camera_);
@@ -261,9 +261,20 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
         std::lock_guard lock(map_.update_mutex());
         for (const auto& point : culled) map_.erase_map_point(point);
       }
-      report.culled_map_points = static_cast<int>(culled.size());
+      report.culled_map_points += static_cast<int>(culled.size());
     }
   }
+}
+
+// The pixels whose map points count towards culling in this frame.
+cv::Mat DynamicPipeline::culling_mask(const DynamicReport& report) const {
+  // A stale mask lies where the people were: the static points they uncovered since would be
+  // culled by it. Its own frame judges it when it arrives (judge_late_frame); here only this
+  // frame's geometry verdicts count.
+  if (options_.realtime && options_.cull_with_late_masks &&
+      report.mask_age_frames > options_.stale_mask_frames)
+    return geometry_mask_;
+  return cull_mask_.empty() ? previous_mask_ : fuse_dynamic_masks(cull_mask_, geometry_mask_, 0);
 }
 
 cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
@@ -278,6 +289,7 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
   if (!result) result = semantic_->newest();
   if (options_.realtime && options_.keep_pace) report.semantic_pace_level = semantic_->level();
   if (!result || result->frame_id > current_id_) return {};
+  if (options_.realtime && options_.cull_with_late_masks) judge_late_frame(*result, report);
   cv::Mat mask;
   if (propagator_) {
     mask = propagate_mask(*result, report);
@@ -297,6 +309,29 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
       report.mask_latency_ms = milliseconds_since(submitted.time);
   }
   return mask;
+}
+
+void DynamicPipeline::judge_late_frame(const SemanticResult& result, DynamicReport& report) {
+  const std::optional<SegmentedFrame> frame = late_mask_frames_.take(result.frame_id);
+  if (!frame || protect_map_ || frame->map_id != map_.active_map()) return;
+  const auto points = map_.reference_map_points();
+  const auto& culled =
+      culler_.observe(points, frame->T_world_camera, result.dynamic_mask, frame->depth, camera_);
+  if (!culled.empty()) {
+    std::lock_guard lock(map_.update_mutex());
+    for (const auto& point : culled) map_.erase_map_point(point);
+  }
+  report.late_frame_judged = true;
+  report.culled_by_late_mask = static_cast<int>(culled.size());
+  report.culled_map_points += report.culled_by_late_mask;
+}
+
+void DynamicPipeline::remember_segmented_frame(const TrackResult& result, const cv::Mat& depth,
+                                               const DynamicReport& report) {
+  if (!options_.realtime || !options_.cull_with_late_masks || !semantic_) return;
+  if (last_segmented_ != current_id_ || !result.T_world_camera || depth.empty()) return;
+  if (report.mask_age_frames == 0) return;  // its own mask came in time and was used
+  late_mask_frames_.remember({current_id_, map_.active_map(), *result.T_world_camera, depth});
 }
 
 cv::Mat DynamicPipeline::propagate_mask(const SemanticResult& result, DynamicReport& report) {

@@ -15,6 +15,7 @@
 #include "pspslam/dynamic/dynamic_mode.h"
 #include "pspslam/dynamic/dynamic_point_culler.h"
 #include "pspslam/dynamic/frame_flow.h"
+#include "pspslam/dynamic/late_mask_frames.h"
 #include "pspslam/dynamic/map_reference_views.h"
 #include "pspslam/dynamic/mask_propagator.h"
 #include "pspslam/dynamic/mask_warper.h"
@@ -81,6 +82,12 @@ struct DynamicOptions {
   // instead of the previous frame's fused mask. Not the fused mask as well: it holds last
   // frame's grown mask and regions, and a prior that includes its own growth widens each frame.
   bool tighten_geometry = true;
+  // A live run's mask arrives frames after the frame it was made for, and is exact for that
+  // frame alone. Culling (DynamicPointCuller) then trusts exact masks only: the late mask judges
+  // its own frame, at that frame's pose and depth, so points a stale mask let onto the people
+  // leave the map; a stale mask, which lies where the people were, culls nothing (it would cull
+  // the static points they uncovered since), and the frame's geometry verdicts still count.
+  bool cull_with_late_masks = true;
 };
 
 // What became of one extracted keypoint (pictures of a run: `pspslam run --save-overlays`).
@@ -124,6 +131,10 @@ struct DynamicReport {
   int dynamic_points = 0;     // keypoints geometry flagged (tested or in grown regions)
   int masked_keypoints = 0;   // extracted keypoints dropped as dynamic before tracking
   int culled_map_points = 0;  // map points erased for lying on dynamic pixels
+  // Live runs: an earlier frame judged by its own mask, which arrived now (cull_with_late_masks),
+  // and the map points that culled (a part of culled_map_points).
+  bool late_frame_judged = false;
+  int culled_by_late_mask = 0;
   // Live runs with a pace: the level the mask used was made at, and the thread's level now
   // (-1: no pace or no mask).
   int semantic_level = -1;
@@ -201,6 +212,11 @@ class DynamicPipeline {
   cv::Mat semantic_mask(DynamicReport& report);
   // A live run's older mask moved into the current frame (StaleMaskPolicy::flow).
   cv::Mat propagate_mask(const SemanticResult& result, DynamicReport& report);
+  // Culls the map points a late mask's own frame saw on its people (cull_with_late_masks).
+  void judge_late_frame(const SemanticResult& result, DynamicReport& report);
+  void remember_segmented_frame(const TrackResult& result, const cv::Mat& depth,
+                                const DynamicReport& report);
+  cv::Mat culling_mask(const DynamicReport& report) const;
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;
 
@@ -223,7 +239,8 @@ class DynamicPipeline {
   std::int64_t last_segmented_ = -1;  // the last frame handed to it to segment
   std::int64_t current_id_ = 0;
   std::deque<Submitted> submitted_;
-  std::deque<Reference> references_;                 // newest keyframe first
+  LateMaskFrames late_mask_frames_;   // live runs: segmented frames awaiting their masks
+  std::deque<Reference> references_;  // newest keyframe first
   std::optional<MapReferenceViews> map_references_;  // localisation only
   bool protect_map_ = false;                         // localisation: never erase map points
   std::optional<Eigen::Matrix3d> H_previous_to_current_;

@@ -63,15 +63,18 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
   const RunStatistics& stats = input.statistics;
   if (!dynamic.realtime || !uses_semantics(dynamic.mode) || !dynamic.semantic_masks.empty())
     return nullptr;
-  char line[512];
+  char line[768];
   std::snprintf(line, sizeof(line),
                 "live masks:   %zu frames on a mask older than %d frames; stale masks moved by "
                 "%s (%zu frames by the people's flow), %zu frames with the geometry test "
-                "tightened around them, %zu poses held at the motion model\n",
+                "tightened around them, %zu poses held at the motion model\n"
+                "              culling by exact masks only: %s (%zu frames judged by their own "
+                "late mask, %zu map points culled so)\n",
                 stats.frames_on_stale_mask, stats.stale_mask_frames(),
                 dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography",
                 stats.frames_mask_moved_by_flow, stats.frames_geometry_tightened,
-                stats.frames_pose_held);
+                stats.frames_pose_held, dynamic.cull_with_late_masks ? "on" : "off",
+                stats.late_frames_judged, stats.culled_by_late_masks);
   out << line;
   nlohmann::ordered_json json = {
       {"stale_after_frames", stats.stale_mask_frames()},
@@ -80,6 +83,9 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
       {"frames_mask_moved_by_flow", stats.frames_mask_moved_by_flow},
       {"frames_geometry_tightened", stats.frames_geometry_tightened},
       {"frames_pose_held", stats.frames_pose_held},
+      {"cull_with_late_masks", dynamic.cull_with_late_masks},
+      {"late_frames_judged", stats.late_frames_judged},
+      {"culled_by_late_masks", stats.culled_by_late_masks},
       {"pace", nullptr}};
   if (!dynamic.keep_pace) return json;
   const std::vector<std::filesystem::path> networks =

@@ -156,6 +156,8 @@ void RunStatistics::add_live_masks(const DynamicReport& dynamic) {
   if (dynamic.mask_age_frames > stale_mask_frames_) ++frames_on_stale_mask;
   if (dynamic.mask_moved_by_flow) ++frames_mask_moved_by_flow;
   if (dynamic.geometry_tightened) ++frames_geometry_tightened;
+  if (dynamic.late_frame_judged) ++late_frames_judged;
+  culled_by_late_masks += static_cast<size_t>(dynamic.culled_by_late_mask);
   const auto count = [](std::vector<size_t>& counts, int level) {
     if (level < 0) return;
     if (counts.size() <= static_cast<size_t>(level)) counts.resize(static_cast<size_t>(level) + 1);

@@ -112,6 +112,9 @@ class RunStatistics {
   size_t frames_mask_moved_by_flow = 0;
   size_t frames_geometry_tightened = 0;
   size_t frames_pose_held = 0;  // poses held at the motion model's prediction (MoverGuard)
+  // Earlier frames judged by their own late mask, and the map points that culled.
+  size_t late_frames_judged = 0;
+  size_t culled_by_late_masks = 0;
   // With a semantic pace: frames processed while the thread was at each level, and frames whose
   // mask was made at each level (index = level); how often the thread changed level.
   std::vector<size_t> frames_at_pace_level;

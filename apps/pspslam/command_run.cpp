@@ -428,7 +428,8 @@ void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
   app->add_option("--late-mask-culling", flags.late_mask_culling,
                   "with --realtime: a mask that arrives after its frame was tracked still judges "
                   "that frame; map points the frame saw on its people count towards their "
-                  "culling")
+                  "culling, and a mask more than 2 frames old culls nothing (off: the newest "
+                  "mask culls, however old)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   app->add_option("--mover-guard", flags.mover_guard,

@@ -253,17 +253,22 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     last_pose_ = result.T_world_camera;
     last_pose_id_ = current_id_;
     const cv::Mat cull_mask = culling_mask(report);
-    if (!cull_mask.empty() && !protect_map_) {
-      const auto points = map_.reference_map_points();
-      const auto& culled =
-          culler_.observe(points, *result.T_world_camera, cull_mask, depth, camera_);
-      if (!culled.empty()) {
-        std::lock_guard lock(map_.update_mutex());
-        for (const auto& point : culled) map_.erase_map_point(point);
-      }
-      report.culled_map_points += static_cast<int>(culled.size());
-    }
+    if (!cull_mask.empty() && !protect_map_)
+      report.culled_map_points += cull(*result.T_world_camera, cull_mask, depth);
   }
+}
+
+// Step 6 for one view (pose, dynamic mask, depth): the local map's points seen on its dynamic
+// pixels count towards their culling; those that reach the threshold leave the map. Returns how
+// many did.
+int DynamicPipeline::cull(const Pose& T_world_camera, const cv::Mat& mask, const cv::Mat& depth) {
+  const auto points = map_.reference_map_points();
+  const auto& culled = culler_.observe(points, T_world_camera, mask, depth, camera_);
+  if (!culled.empty()) {
+    std::lock_guard lock(map_.update_mutex());
+    for (const auto& point : culled) map_.erase_map_point(point);
+  }
+  return static_cast<int>(culled.size());
 }
 
 // The pixels whose map points count towards culling in this frame.
@@ -314,15 +319,8 @@ cv::Mat DynamicPipeline::semantic_mask(DynamicReport& report) {
 void DynamicPipeline::judge_late_frame(const SemanticResult& result, DynamicReport& report) {
   const std::optional<SegmentedFrame> frame = late_mask_frames_.take(result.frame_id);
   if (!frame || protect_map_ || frame->map_id != map_.active_map()) return;
-  const auto points = map_.reference_map_points();
-  const auto& culled =
-      culler_.observe(points, frame->T_world_camera, result.dynamic_mask, frame->depth, camera_);
-  if (!culled.empty()) {
-    std::lock_guard lock(map_.update_mutex());
-    for (const auto& point : culled) map_.erase_map_point(point);
-  }
   report.late_frame_judged = true;
-  report.culled_by_late_mask = static_cast<int>(culled.size());
+  report.culled_by_late_mask = cull(frame->T_world_camera, result.dynamic_mask, frame->depth);
   report.culled_map_points += report.culled_by_late_mask;
 }
 

@@ -217,6 +217,7 @@ class DynamicPipeline {
   void remember_segmented_frame(const TrackResult& result, const cv::Mat& depth,
                                 const DynamicReport& report);
   cv::Mat culling_mask(const DynamicReport& report) const;
+  int cull(const Pose& T_world_camera, const cv::Mat& mask, const cv::Mat& depth);
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;
 

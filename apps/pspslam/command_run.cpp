@@ -114,6 +114,7 @@ struct RunFlags {
   std::string mover_guard = "off";
   std::string stale_geometry = "on";
   std::string late_mask_culling = "on";
+  std::string judged_points_first = "on";
   std::string semantic_delay;  // empty: none (fault injection)
   std::uint32_t semantic_delay_seed = 1;
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
@@ -188,6 +189,7 @@ void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
   system.tracker.mover_guard.enabled = flags.mover_guard == "on";
   dynamic.tighten_geometry = flags.stale_geometry == "on";
   dynamic.cull_with_late_masks = flags.late_mask_culling == "on";
+  system.tracker.judged_points_first = flags.judged_points_first == "on";
   dynamic.propagation.max_growth_px = flags.stale_mask_growth;
   dynamic.stale_masks =
       flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
@@ -430,6 +432,13 @@ void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
                   "that frame; map points the frame saw on its people count towards their "
                   "culling, and a mask more than 2 frames old culls nothing (off: the newest "
                   "mask culls, however old)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--judged-points-first", flags.judged_points_first,
+                  "with --realtime and --late-mask-culling on: while the mask is more than 2 "
+                  "frames old, a frame's pose is solved on the map points an exact mask has "
+                  "judged first, and newer points count only where they agree with it (off: "
+                  "every match alike, which lets a crowd the stale mask missed carry the pose)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   app->add_option("--mover-guard", flags.mover_guard,

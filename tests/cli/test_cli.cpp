@@ -695,6 +695,12 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   EXPECT_LE(masks["late_frames_judged"].get<int>(), stats["frames"].get<int>());
   EXPECT_LE(masks["culled_by_late_masks"].get<int>(),
             stats["dynamic"]["culled_map_points"].get<int>());
+  // On a stale mask, poses are solved on the judged map points first; each pose that set newer
+  // matches aside set at least one aside.
+  EXPECT_TRUE(masks["judged_points_first"].get<bool>());
+  EXPECT_TRUE(contains(live.output, "judged points first: on (")) << live.output;
+  EXPECT_LE(masks["poses_judged_first"].get<int>(), stats["frames"].get<int>());
+  EXPECT_GE(masks["unjudged_matches_set_aside"].get<int>(), masks["poses_judged_first"].get<int>());
   const nlohmann::json& levels = masks["pace"]["levels"];
   ASSERT_EQ(levels.size(), 4u);
   EXPECT_EQ(levels[1]["network"].get<std::string>(), "pspnet_288x192.yaml (288x192)");

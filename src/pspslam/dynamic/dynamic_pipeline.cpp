@@ -271,6 +271,13 @@ int DynamicPipeline::cull(const Pose& T_world_camera, const cv::Mat& mask, const
   return static_cast<int>(culled.size());
 }
 
+std::optional<int> DynamicPipeline::frames_since_judged(const DynamicReport& report) const {
+  if (!options_.realtime || !options_.cull_with_late_masks || protect_map_ ||
+      report.mask_age_frames <= options_.stale_mask_frames)
+    return std::nullopt;
+  return report.mask_age_frames;
+}
+
 // The pixels whose map points count towards culling in this frame.
 cv::Mat DynamicPipeline::culling_mask(const DynamicReport& report) const {
   // A stale mask lies where the people were: the static points they uncovered since would be

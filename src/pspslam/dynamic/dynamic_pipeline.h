@@ -166,6 +166,11 @@ class DynamicPipeline {
   // throws pspslam::Error naming the file when it is missing or not the frame's size.
   cv::Mat begin_frame(const InputFrame& frame, const cv::Mat& gray, DynamicReport& report);
 
+  // Live runs culling with late masks, on a stale mask: how many frames back the newest frame an
+  // exact mask has judged is (its map points and older ones were culled where it saw people,
+  // newer ones not yet). Nothing when the mask is fresh or absent.
+  std::optional<int> frames_since_judged(const DynamicReport& report) const;
+
   // Step 4: geometry verdicts fused with the semantic mask; dynamic keypoints are removed.
   // `keypoint_depths`: each keypoint's own depth measurement (FrameBuilder::keypoint_depths;
   // empty: the geometry stage reads `depth` at the keypoint's pixel). `dropped` (null unless

@@ -152,12 +152,12 @@ void KeyFrame::update_connections() {
   std::map<std::uint64_t, Connection> counts;
   for (const auto& point : map_points()) {
     if (!point) continue;
-    for (const auto& [kf_id, obs] : point->observations()) {
-      if (kf_id == id_) continue;
+    point->for_each_observation([&](std::uint64_t kf_id, const MapPoint::Observation& obs) {
+      if (kf_id == id_) return;
       Connection& c = counts[kf_id];
       if (c.weight == 0) c.keyframe = obs.keyframe;
       ++c.weight;
-    }
+    });
   }
   if (counts.empty()) return;
 

@@ -10,7 +10,10 @@ namespace pspslam {
 
 MapPoint::MapPoint(std::uint64_t id, const Eigen::Vector3d& position_world,
                    const std::shared_ptr<KeyFrame>& reference_keyframe)
-    : id_(id), position_(position_world), reference_keyframe_(reference_keyframe) {
+    : id_(id),
+      position_(position_world),
+      reference_keyframe_(reference_keyframe),
+      first_frame_id_(reference_keyframe ? reference_keyframe->frame_id() : 0) {
   if (reference_keyframe) first_keyframe_id = reference_keyframe->id();
 }
 

@@ -38,6 +38,9 @@ class MapPoint {
   double min_distance() const;
   double max_distance() const;
   std::shared_ptr<KeyFrame> reference_keyframe() const;
+  // The frame whose keyframe made the point (0 without one). Unlike the reference keyframe it
+  // never changes, so it says how long the point has been in the map.
+  std::uint64_t first_frame_id() const { return first_frame_id_; }
 
   // Observations, keyed by keyframe id. An observation with depth counts twice (as a stereo
   // observation does in ORB-SLAM2) in num_observations().
@@ -45,6 +48,14 @@ class MapPoint {
   // Returns true when the point became bad because too few observations remain.
   bool erase_observation(std::uint64_t keyframe_id);
   std::map<std::uint64_t, Observation> observations() const;
+  // Calls fn(keyframe_id, observation) for each observation in keyframe-id order, under the
+  // point's lock and without copying them (tracking's hot path); fn must not call back into
+  // this point.
+  template <typename Fn>
+  void for_each_observation(Fn&& fn) const {
+    std::lock_guard lock(observation_mutex_);
+    for (const auto& [keyframe_id, observation] : observations_) fn(keyframe_id, observation);
+  }
   int num_observations() const;
   int keypoint_index_in(std::uint64_t keyframe_id) const;  // -1 if not observed there
   bool is_observed_by(std::uint64_t keyframe_id) const;
@@ -88,6 +99,7 @@ class MapPoint {
   int num_observations_ = 0;
   OrbDescriptor descriptor_{};
   std::weak_ptr<KeyFrame> reference_keyframe_;
+  const std::uint64_t first_frame_id_;
   std::weak_ptr<MapPoint> replaced_by_;
   int visible_ = 1;
   int found_ = 1;

@@ -69,12 +69,15 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
                 "%s (%zu frames by the people's flow), %zu frames with the geometry test "
                 "tightened around them, %zu poses held at the motion model\n"
                 "              culling by exact masks only: %s (%zu frames judged by their own "
-                "late mask, %zu map points culled so)\n",
+                "late mask, %zu map points culled so); judged points first: %s (%zu poses set "
+                "%zu newer matches aside)\n",
                 stats.frames_on_stale_mask, stats.stale_mask_frames(),
                 dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography",
                 stats.frames_mask_moved_by_flow, stats.frames_geometry_tightened,
                 stats.frames_pose_held, dynamic.cull_with_late_masks ? "on" : "off",
-                stats.late_frames_judged, stats.culled_by_late_masks);
+                stats.late_frames_judged, stats.culled_by_late_masks,
+                input.options.system.tracker.judged_points_first ? "on" : "off",
+                stats.poses_judged_first, stats.unjudged_matches_set_aside);
   out << line;
   nlohmann::ordered_json json = {
       {"stale_after_frames", stats.stale_mask_frames()},
@@ -86,6 +89,9 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
       {"cull_with_late_masks", dynamic.cull_with_late_masks},
       {"late_frames_judged", stats.late_frames_judged},
       {"culled_by_late_masks", stats.culled_by_late_masks},
+      {"judged_points_first", input.options.system.tracker.judged_points_first},
+      {"poses_judged_first", stats.poses_judged_first},
+      {"unjudged_matches_set_aside", stats.unjudged_matches_set_aside},
       {"pace", nullptr}};
   if (!dynamic.keep_pace) return json;
   const std::vector<std::filesystem::path> networks =

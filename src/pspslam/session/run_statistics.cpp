@@ -53,6 +53,8 @@ void RunStatistics::add_frame(size_t index, const FrameReport& report, LocalBaTi
   const DynamicReport& dyn = report.dynamic;
   add_live_masks(dyn);
   if (result.pose_held) ++frames_pose_held;
+  if (result.unjudged_matches_set_aside > 0) ++poses_judged_first;
+  unjudged_matches_set_aside += static_cast<size_t>(result.unjudged_matches_set_aside);
   tested_points += dyn.tested_points;
   dynamic_points += dyn.dynamic_points;
   masked_keypoints += dyn.masked_keypoints;

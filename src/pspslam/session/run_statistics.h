@@ -112,6 +112,9 @@ class RunStatistics {
   size_t frames_mask_moved_by_flow = 0;
   size_t frames_geometry_tightened = 0;
   size_t frames_pose_held = 0;  // poses held at the motion model's prediction (MoverGuard)
+  // Poses solved on judged map points first that set newer matches aside, and those matches.
+  size_t poses_judged_first = 0;
+  size_t unjudged_matches_set_aside = 0;
   // Earlier frames judged by their own late mask, and the map points that culled.
   size_t late_frames_judged = 0;
   size_t culled_by_late_masks = 0;

@@ -106,7 +106,7 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
   back_end_.wait_for_back_end();
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
-  report.tracking = tracker_.track(std::move(tracked_frame));
+  report.tracking = tracker_.track(std::move(tracked_frame), judged_through_frame(report));
   if (report.tracking.restart_due) restart_map();
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
@@ -120,6 +120,16 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
   }
   if (fates) record_fates_of_tracked_frame(*fates);
   return report;
+}
+
+// The newest frame whose map points an exact semantic mask has judged, while a live run's mask is
+// stale (Tracker::track).
+std::optional<std::uint64_t> TrackingModule::judged_through_frame(const FrameReport& report) const {
+  if (!dynamic_) return std::nullopt;
+  const std::optional<int> back = dynamic_->frames_since_judged(report.dynamic);
+  const std::uint64_t frame_id = next_frame_id_ - 1;
+  if (!back || static_cast<std::uint64_t>(*back) > frame_id) return std::nullopt;
+  return frame_id - static_cast<std::uint64_t>(*back);
 }
 
 void TrackingModule::reanchor_dynamic_pipeline() {

@@ -43,6 +43,55 @@ PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOpti
   return optimized;
 }
 
+PoseOptimizationResult optimize_frame_pose_judged_first(
+    Frame& frame, const PoseOptimizerOptions& options, FramePoseBuffers& buffers,
+    const PosePrior* prior, const JudgedPoints& judged, int& set_aside) {
+  set_aside = 0;
+  gather_observations(frame, /*inliers_only=*/false, buffers);
+  const std::vector<PoseObservation>& all = buffers.observations;
+  std::vector<uint8_t> use(all.size(), 0);
+  int judged_matches = 0;
+  for (size_t k = 0; k < all.size(); ++k) {
+    const std::uint64_t made =
+        frame.map_points[buffers.keypoint_of_observation[k]]->first_frame_id();
+    use[k] = made <= judged.judged_through_frame || made > frame.id();
+    judged_matches += use[k];
+  }
+  if (judged_matches < judged.min_points || judged_matches == static_cast<int>(all.size()))
+    return optimize_frame_pose(frame, options, buffers, prior);
+
+  const PinholeCamera& pinhole = frame.camera().pinhole;
+  const double bf = frame.camera().bf;
+  auto solve_on = [&](const Pose& start) {
+    buffers.subset.clear();
+    buffers.subset_of_observation.clear();
+    for (size_t k = 0; k < all.size(); ++k) {
+      if (!use[k]) continue;
+      buffers.subset.push_back(all[k]);
+      buffers.subset_of_observation.push_back(k);
+    }
+    return optimize_pose(pinhole, bf, start, buffers.subset, options, prior);
+  };
+  const PoseOptimizationResult on_judged = solve_on(frame.T_camera_world());
+  const std::vector<uint8_t> agrees =
+      classify_observations(pinhole, bf, on_judged.T_camera_world, all, options);
+  for (size_t k = 0; k < all.size(); ++k) {
+    if (use[k]) continue;
+    use[k] = agrees[k];
+    set_aside += !agrees[k];
+  }
+  const PoseOptimizationResult final_solve = solve_on(on_judged.T_camera_world);
+
+  PoseOptimizationResult result;
+  result.T_camera_world = final_solve.T_camera_world;
+  result.inlier.assign(all.size(), 0);
+  for (size_t j = 0; j < buffers.subset_of_observation.size(); ++j)
+    result.inlier[buffers.subset_of_observation[j]] = final_solve.inlier[j];
+  result.num_inliers = final_solve.num_inliers;
+  frame.set_pose(orthonormalized(result.T_camera_world));
+  return result;
+}
+
 RollingShutterPose refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
                                               double sigma_rate, FramePoseBuffers& buffers) {
   const CameraModel& camera = frame.camera();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "pspslam/core/types.h"
@@ -20,6 +21,8 @@ struct FramePoseBuffers {
   std::vector<PoseObservation> observations;
   std::vector<int> keypoint_of_observation;  // frame keypoint index of observations[k]
   std::vector<double> row_times;             // refine_frame_rotation_rate only
+  std::vector<PoseObservation> subset;       // optimize_frame_pose_judged_first only
+  std::vector<size_t> subset_of_observation;
 };
 
 // Pose-only optimisation of `frame` on its current map point matches (every keypoint with a map
@@ -30,6 +33,27 @@ struct FramePoseBuffers {
 PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
                                            FramePoseBuffers& buffers,
                                            const PosePrior* prior = nullptr);
+
+// The map points a live frame's pose leans on first (optimize_frame_pose_judged_first).
+struct JudgedPoints {
+  // Points made by keyframes of this frame or older ones: an exact semantic mask has judged them.
+  std::uint64_t judged_through_frame = 0;
+  // Fewer matches to judged points than this: the pose is solved on every match, as usual.
+  int min_points = 30;
+};
+
+// optimize_frame_pose for a live frame whose semantic mask is stale. Points made since the newest
+// frame an exact mask judged may sit on people the stale mask missed; where people fill the view
+// they outnumber the static matches and carry the pose with them. So the pose is solved on the
+// judged points first, and a newer point joins the final solve only where it agrees with that
+// pose; the others are outliers. A point made after this frame (a loaded map's) counts as judged.
+// With fewer than `judged.min_points` judged matches, or no newer ones, this is
+// optimize_frame_pose. `set_aside`: the newer matches left out of the final solve.
+PoseOptimizationResult optimize_frame_pose_judged_first(Frame& frame,
+                                                        const PoseOptimizerOptions& options,
+                                                        FramePoseBuffers& buffers,
+                                                        const PosePrior* prior,
+                                                        const JudgedPoints& judged, int& set_aside);
 
 // The frame's pose from its map point matches alone (PnP-RANSAC), for a frame whose last pose is
 // stale or unknown (recovery, a lost frame placed in a new map): set on the frame, the matches

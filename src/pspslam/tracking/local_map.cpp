@@ -22,11 +22,11 @@ std::shared_ptr<KeyFrame> LocalMap::update(const Frame& frame) {
   for (int i = 0; i < frame.size(); ++i) {
     const auto& point = frame.map_points[i];
     if (!point || frame.outlier[i] || point->is_bad()) continue;
-    for (const auto& [kf_id, obs] : point->observations()) {
+    point->for_each_observation([&](std::uint64_t kf_id, const MapPoint::Observation& obs) {
       auto& vote = votes[kf_id];
       if (!vote.first) vote.first = obs.keyframe.lock();
       ++vote.second;
-    }
+    });
   }
   keyframes_.clear();
   std::shared_ptr<KeyFrame> reference;

@@ -59,8 +59,11 @@ Tracker::Tracker(Map& map, KeyFrameSink* sink, TrackerOptions options,
 
 Tracker::~Tracker() = default;
 
-TrackResult Tracker::track(Frame frame) {
+TrackResult Tracker::track(Frame frame, std::optional<std::uint64_t> judged_through_frame) {
   std::lock_guard map_lock(map_.update_mutex());
+  judged_through_frame_ =
+      options_.judged_points_first ? judged_through_frame : std::optional<std::uint64_t>();
+  unjudged_matches_set_aside_ = 0;
   TrackResult result;
   result.frame_id = frame.id();
   result.timestamp = frame.timestamp();
@@ -105,6 +108,7 @@ TrackResult Tracker::track(Frame frame) {
 
   result.state = state_;
   result.map_id = map_.active_map();
+  result.unjudged_matches_set_aside = unjudged_matches_set_aside_;
   if (state_ == TrackingState::kOk && frame.has_pose()) {
     lost_since_.reset();
     result.T_world_camera = frame.T_world_camera();
@@ -339,8 +343,16 @@ std::optional<TrackedMotion> Tracker::tracked_motion(const Frame& frame) {
 }
 
 int Tracker::optimize_frame_pose(Frame& frame) {
-  const PoseOptimizationResult optimized = pspslam::optimize_frame_pose(
-      frame, options_.pose_optimizer, pose_buffers_, motion_prior_ ? &*motion_prior_ : nullptr);
+  const PosePrior* prior = motion_prior_ ? &*motion_prior_ : nullptr;
+  int set_aside = 0;
+  const PoseOptimizationResult optimized =
+      judged_through_frame_
+          ? optimize_frame_pose_judged_first(frame, options_.pose_optimizer, pose_buffers_, prior,
+                                             {.judged_through_frame = *judged_through_frame_,
+                                              .min_points = options_.min_judged_points},
+                                             set_aside)
+          : pspslam::optimize_frame_pose(frame, options_.pose_optimizer, pose_buffers_, prior);
+  unjudged_matches_set_aside_ = set_aside;  // the last solve's verdict is the frame's
   for (size_t k = 0; k < pose_buffers_.keypoint_of_observation.size(); ++k) {
     frame.outlier[pose_buffers_.keypoint_of_observation[k]] = optimized.inlier[k] ? 0 : 1;
   }

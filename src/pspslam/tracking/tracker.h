@@ -60,6 +60,11 @@ struct TrackerOptions {
   double new_map_after_seconds = 0.0;
   // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).
   MoverGuardOptions mover_guard;
+  // A frame given a judged_through_frame (a live frame on a stale mask) solves its pose on the
+  // judged points first (optimize_frame_pose_judged_first); off: on every match
+  // (docs/decisions/judged-points-first.md).
+  bool judged_points_first = true;
+  int min_judged_points = 30;
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
@@ -107,6 +112,9 @@ struct TrackResult {
   // The pose is the motion model's prediction: the optimised one followed a moving cluster
   // (MoverGuard).
   bool pose_held = false;
+  // Matches to points made since the frame given as judged_through_frame that the pose did not
+  // use: they disagreed with the pose the judged points gave (TrackerOptions::judged_points_first).
+  int unjudged_matches_set_aside = 0;
   // The map of the atlas the pose is in (Map::active_map), as it was when the frame was tracked.
   std::uint32_t map_id = 0;
   // The frame started a map while others existed (TrackerOptions::new_map_after_seconds).
@@ -139,7 +147,10 @@ class Tracker {
           std::unique_ptr<MapInitializer> initializer = nullptr);
   ~Tracker();
 
-  TrackResult track(Frame frame);
+  // `judged_through_frame`: the map points made by this frame's keyframes and older ones have
+  // been judged by an exact semantic mask, newer ones not yet (a live run's stale mask); see
+  // TrackerOptions::judged_points_first.
+  TrackResult track(Frame frame, std::optional<std::uint64_t> judged_through_frame = std::nullopt);
 
   // Every tracked frame moved by the corrections mapping has since applied to the keyframes
   // around it in time, never across a loop correction or global BA
@@ -224,7 +235,9 @@ class Tracker {
   // The constant-velocity prediction of the frame being tracked with the motion model.
   std::optional<Pose> predicted_pose_;
   MoverGuard mover_guard_;
-  std::optional<Pose> last_tracked_pose_;  // T_camera_world of the latest tracked frame
+  std::optional<std::uint64_t> judged_through_frame_;  // of the frame being tracked
+  int unjudged_matches_set_aside_ = 0;                 // by the frame being tracked
+  std::optional<Pose> last_tracked_pose_;              // T_camera_world of the latest tracked frame
   std::shared_ptr<KeyFrame> reference_keyframe_;
   std::weak_ptr<KeyFrame> last_keyframe_;  // the keyframe this tracker made last
   std::uint64_t last_keyframe_frame_id_ = 0;

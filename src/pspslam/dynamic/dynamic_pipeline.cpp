@@ -271,10 +271,15 @@ int DynamicPipeline::cull(const Pose& T_world_camera, const cv::Mat& mask, const
   return static_cast<int>(culled.size());
 }
 
+// A live run culling on exact masks only, whose mask for this frame is stale: only late masks,
+// each at its own frame, judge the map's points.
+bool DynamicPipeline::judged_by_late_masks_only(const DynamicReport& report) const {
+  return options_.realtime && options_.cull_with_late_masks &&
+         report.mask_age_frames > options_.stale_mask_frames;
+}
+
 std::optional<int> DynamicPipeline::frames_since_judged(const DynamicReport& report) const {
-  if (!options_.realtime || !options_.cull_with_late_masks || protect_map_ ||
-      report.mask_age_frames <= options_.stale_mask_frames)
-    return std::nullopt;
+  if (protect_map_ || !judged_by_late_masks_only(report)) return std::nullopt;
   return report.mask_age_frames;
 }
 
@@ -283,9 +288,7 @@ cv::Mat DynamicPipeline::culling_mask(const DynamicReport& report) const {
   // A stale mask lies where the people were: the static points they uncovered since would be
   // culled by it. Its own frame judges it when it arrives (judge_late_frame); here only this
   // frame's geometry verdicts count.
-  if (options_.realtime && options_.cull_with_late_masks &&
-      report.mask_age_frames > options_.stale_mask_frames)
-    return geometry_mask_;
+  if (judged_by_late_masks_only(report)) return geometry_mask_;
   return cull_mask_.empty() ? previous_mask_ : fuse_dynamic_masks(cull_mask_, geometry_mask_, 0);
 }
 

@@ -221,6 +221,7 @@ class DynamicPipeline {
   void judge_late_frame(const SemanticResult& result, DynamicReport& report);
   void remember_segmented_frame(const TrackResult& result, const cv::Mat& depth,
                                 const DynamicReport& report);
+  bool judged_by_late_masks_only(const DynamicReport& report) const;
   cv::Mat culling_mask(const DynamicReport& report) const;
   int cull(const Pose& T_world_camera, const cv::Mat& mask, const cv::Mat& depth);
   void collect_reference_views();

@@ -207,17 +207,15 @@ ceres::Solver::Options round_solver_options(const PoseOptimizerOptions& options)
 
 }  // namespace
 
-std::vector<uint8_t> classify_observations(const PinholeCamera& camera, double bf,
-                                           const Pose& T_camera_world,
-                                           const std::vector<PoseObservation>& observations,
-                                           const PoseOptimizerOptions& options) {
+void classify_observations(const PinholeCamera& camera, double bf, const Pose& T_camera_world,
+                           const std::vector<PoseObservation>& observations,
+                           const PoseOptimizerOptions& options, std::vector<uint8_t>& inlier) {
   const StereoProjection model = StereoProjection::from(camera, bf, options.depth_noise);
-  std::vector<uint8_t> inlier(observations.size(), 0);
+  inlier.assign(observations.size(), 0);
   classify_by_chi2(
       observations, options.chi2_mono, options.chi2_stereo,
       [&](size_t i) { return observation_chi_squared(model, observations[i], T_camera_world); },
       inlier);
-  return inlier;
 }
 
 PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,

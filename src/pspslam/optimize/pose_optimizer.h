@@ -85,11 +85,11 @@ PoseOptimizationResult optimize_pose(const PinholeCamera& camera, double bf,
                                      const PosePrior* prior = nullptr);
 
 // The χ² verdicts of optimize_pose's last round (1 = inlier at 95 %) on `observations` seen from
-// `T_camera_world`, without optimising: which of them agree with a pose found on others.
-std::vector<uint8_t> classify_observations(const PinholeCamera& camera, double bf,
-                                           const Pose& T_camera_world,
-                                           const std::vector<PoseObservation>& observations,
-                                           const PoseOptimizerOptions& options = {});
+// `T_camera_world`, without optimising, into `inlier` (resized): which of them agree with a pose
+// found on others.
+void classify_observations(const PinholeCamera& camera, double bf, const Pose& T_camera_world,
+                           const std::vector<PoseObservation>& observations,
+                           const PoseOptimizerOptions& options, std::vector<uint8_t>& inlier);
 
 // The information of a prior alone: diag(1/σ_r², 1/σ_r², 1/σ_r², 1/σ_t², 1/σ_t², 1/σ_t²).
 PoseInformation prior_information(const PosePrior& prior);

@@ -106,7 +106,8 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
   back_end_.wait_for_back_end();
   const double cpu_tracking_start = thread_cpu_ms();
   const auto tracking_start = std::chrono::steady_clock::now();
-  report.tracking = tracker_.track(std::move(tracked_frame), judged_through_frame(report));
+  const std::optional<std::uint64_t> judged = judged_through_frame(tracked_frame.id(), report);
+  report.tracking = tracker_.track(std::move(tracked_frame), judged);
   if (report.tracking.restart_due) restart_map();
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
@@ -124,10 +125,10 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
 
 // The newest frame whose map points an exact semantic mask has judged, while a live run's mask is
 // stale (Tracker::track).
-std::optional<std::uint64_t> TrackingModule::judged_through_frame(const FrameReport& report) const {
+std::optional<std::uint64_t> TrackingModule::judged_through_frame(std::uint64_t frame_id,
+                                                                  const FrameReport& report) const {
   if (!dynamic_) return std::nullopt;
   const std::optional<int> back = dynamic_->frames_since_judged(report.dynamic);
-  const std::uint64_t frame_id = next_frame_id_ - 1;
   if (!back || static_cast<std::uint64_t>(*back) > frame_id) return std::nullopt;
   return frame_id - static_cast<std::uint64_t>(*back);
 }

@@ -92,7 +92,8 @@ class TrackingModule {
   void restart_map();
   // After a loop correction, the geometry prior starts from the tracker's corrected pose.
   void reanchor_dynamic_pipeline();
-  std::optional<std::uint64_t> judged_through_frame(const FrameReport& report) const;
+  std::optional<std::uint64_t> judged_through_frame(std::uint64_t frame_id,
+                                                    const FrameReport& report) const;
   void record_fates_before_removal(const cv::Mat& gray, const cv::Mat& semantic_mask,
                                    std::vector<KeypointRecord>& records);
   void record_fates_of_tracked_frame(std::vector<KeypointRecord>& records) const;

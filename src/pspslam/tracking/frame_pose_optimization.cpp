@@ -33,14 +33,24 @@ Pose orthonormalized(const Pose& pose) {
   return out;
 }
 
-PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
-                                           FramePoseBuffers& buffers, const PosePrior* prior) {
-  gather_observations(frame, /*inliers_only=*/false, buffers);
+namespace {
+
+// optimize_frame_pose on observations already gathered into `buffers`.
+PoseOptimizationResult solve_gathered(Frame& frame, const PoseOptimizerOptions& options,
+                                      const FramePoseBuffers& buffers, const PosePrior* prior) {
   PoseOptimizationResult optimized =
       optimize_pose(frame.camera().pinhole, frame.camera().bf, frame.T_camera_world(),
                     buffers.observations, options, prior);
   frame.set_pose(orthonormalized(optimized.T_camera_world));
   return optimized;
+}
+
+}  // namespace
+
+PoseOptimizationResult optimize_frame_pose(Frame& frame, const PoseOptimizerOptions& options,
+                                           FramePoseBuffers& buffers, const PosePrior* prior) {
+  gather_observations(frame, /*inliers_only=*/false, buffers);
+  return solve_gathered(frame, options, buffers, prior);
 }
 
 PoseOptimizationResult optimize_frame_pose_judged_first(
@@ -49,7 +59,8 @@ PoseOptimizationResult optimize_frame_pose_judged_first(
   set_aside = 0;
   gather_observations(frame, /*inliers_only=*/false, buffers);
   const std::vector<PoseObservation>& all = buffers.observations;
-  std::vector<uint8_t> use(all.size(), 0);
+  std::vector<uint8_t>& use = buffers.use;
+  use.assign(all.size(), 0);
   int judged_matches = 0;
   for (size_t k = 0; k < all.size(); ++k) {
     const std::uint64_t made =
@@ -58,7 +69,7 @@ PoseOptimizationResult optimize_frame_pose_judged_first(
     judged_matches += use[k];
   }
   if (judged_matches < judged.min_points || judged_matches == static_cast<int>(all.size()))
-    return optimize_frame_pose(frame, options, buffers, prior);
+    return solve_gathered(frame, options, buffers, prior);
 
   const PinholeCamera& pinhole = frame.camera().pinhole;
   const double bf = frame.camera().bf;
@@ -73,12 +84,11 @@ PoseOptimizationResult optimize_frame_pose_judged_first(
     return optimize_pose(pinhole, bf, start, buffers.subset, options, prior);
   };
   const PoseOptimizationResult on_judged = solve_on(frame.T_camera_world());
-  const std::vector<uint8_t> agrees =
-      classify_observations(pinhole, bf, on_judged.T_camera_world, all, options);
+  classify_observations(pinhole, bf, on_judged.T_camera_world, all, options, buffers.agrees);
   for (size_t k = 0; k < all.size(); ++k) {
     if (use[k]) continue;
-    use[k] = agrees[k];
-    set_aside += !agrees[k];
+    use[k] = buffers.agrees[k];
+    set_aside += !buffers.agrees[k];
   }
   const PoseOptimizationResult final_solve = solve_on(on_judged.T_camera_world);
 

@@ -21,7 +21,11 @@ struct FramePoseBuffers {
   std::vector<PoseObservation> observations;
   std::vector<int> keypoint_of_observation;  // frame keypoint index of observations[k]
   std::vector<double> row_times;             // refine_frame_rotation_rate only
-  std::vector<PoseObservation> subset;       // optimize_frame_pose_judged_first only
+  // optimize_frame_pose_judged_first only: which observations a solve uses, which agree with
+  // the judged points' pose, and the solve's own observations.
+  std::vector<uint8_t> use;
+  std::vector<uint8_t> agrees;
+  std::vector<PoseObservation> subset;
   std::vector<size_t> subset_of_observation;
 };
 

@@ -103,8 +103,9 @@ struct RunFlags {
   std::string semantic_masks;  // empty: the network segments the frames
   bool realtime = false;
   std::string preload = "auto";
-  int background_nice = -1;  // -1: kLiveBackgroundNice for live runs, else 0
-  int opencv_threads = -1;   // -1: 1 for live runs, else OpenCV's default (all cores)
+  int background_nice = -1;     // -1: kLiveBackgroundNice for live runs, else 0
+  std::optional<int> priority;  // none: kLiveFramePathNice for live runs, else 0
+  int opencv_threads = -1;      // -1: 1 for live runs, else OpenCV's default (all cores)
   int mask_margin = 5;
   int segment_every = 1;
   std::string semantic_pace = "off";
@@ -112,6 +113,7 @@ struct RunFlags {
   std::string stale_masks = "homography";
   int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
   std::string mover_guard = "off";
+  std::string jump_guard = "on";
   std::string stale_geometry = "on";
   std::string late_mask_culling = "on";
   std::string judged_points_first = "on";
@@ -187,6 +189,7 @@ void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
   else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
     dynamic.smaller_model = shipped_smaller;
   system.tracker.mover_guard.enabled = flags.mover_guard == "on";
+  system.tracker.mover_guard.hold_jumps_on_stale_masks = flags.jump_guard == "on";
   dynamic.tighten_geometry = flags.stale_geometry == "on";
   dynamic.cull_with_late_masks = flags.late_mask_culling == "on";
   system.tracker.judged_points_first = flags.judged_points_first == "on";
@@ -253,6 +256,20 @@ std::unique_ptr<LiveViewer> start_viewer(const RunFlags& flags, const SystemOpti
   return viewer;
 }
 
+void report_priority(const ScopedThreadPriority& priority) {
+  if (priority.wanted() >= 0) return;
+  if (priority.raised()) {
+    std::cout << "priority:     tracking at nice " << priority.wanted()
+              << " (above busy programs of normal priority)" << std::endl;
+  } else {
+    std::cout << "priority:     tracking at nice " << this_thread_nice() << ": raising it to "
+              << priority.wanted()
+              << " needs root or CAP_SYS_NICE, so busy programs beside the run can make it drop "
+                 "frames (--priority 0 stops asking)"
+              << std::endl;
+  }
+}
+
 int exit_status(RunOutcome outcome) {
   switch (outcome) {
     case RunOutcome::disconnected:
@@ -292,6 +309,11 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   if (!flags.realtime && live && live->source->live())
     system.back_end_wait = BackEndWait::local_mapping;
   std::unique_ptr<LiveViewer> viewer = start_viewer(flags, system);
+  // Raised before the runner starts its threads (a recording's reader, the System's): they inherit
+  // it, and the background threads lower theirs from it.
+  const ScopedThreadPriority priority(
+      flags.priority.value_or(settings.live() ? kLiveFramePathNice : 0));
+  report_priority(priority);
   SequenceRunner runner = live ? SequenceRunner(std::move(*live), std::move(options), std::cout)
                                : SequenceRunner(std::move(options), std::cout);
   runner.watch(viewer.get());
@@ -379,11 +401,18 @@ void add_live_options(CLI::App* app, RunFlags& flags) {
       ->capture_default_str();
   app->add_option("--background-nice", flags.background_nice,
                   "scheduling priority given up by the semantic, local mapping and loop closing "
-                  "threads (nice increment, 0-19) so that tracking gets a core when a frame "
-                  "arrives (default: " +
+                  "threads below tracking's (nice increment, 0-19) so that tracking gets a core "
+                  "when a frame arrives (default: " +
                       std::to_string(kLiveBackgroundNice) +
                       " with --realtime or --camera, 0 otherwise)")
       ->check(in_range(0, 19));
+  app->add_option("--priority", flags.priority,
+                  "nice value asked for tracking and the threads it starts, so that it keeps up "
+                  "with the camera beside busy programs (needs root or CAP_SYS_NICE; without, "
+                  "the run says so and goes on). Default: " +
+                      std::to_string(kLiveFramePathNice) +
+                      " with --realtime or --camera, 0 (unchanged) otherwise")
+      ->check(in_range(-20, 0));
   app->add_option("--opencv-threads", flags.opencv_threads,
                   "OpenCV worker threads (network, image operations; 0 = OpenCV's default, all "
                   "cores). Default: 1 with --realtime or --camera, so that the network runs on "
@@ -445,6 +474,13 @@ void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
                   "experimental: when a frame's inliers drop and its pose jumps off the "
                   "constant-velocity prediction (tracking following a crowd), hold the "
                   "prediction for up to 3 frames")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  app->add_option("--jump-guard", flags.jump_guard,
+                  "with --realtime and --late-mask-culling on: while the mask is more than 2 "
+                  "frames old, a pose that leaves the constant-velocity prediction faster than a "
+                  "camera moves (6 m/s, 6 rad/s) is held at the prediction for up to 3 frames, "
+                  "and no keyframe is made from it")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
 }

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -678,6 +680,13 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   const Result live = pspslam(run + (dir / "live").string() + " --realtime --semantic-pace on");
   ASSERT_EQ(live.status, 0) << live.output;
   EXPECT_TRUE(contains(live.output, "live masks:   ")) << live.output;
+  EXPECT_TRUE(contains(live.output,
+                       geteuid() == 0
+                           ? "priority:     tracking at nice -10 (above busy programs of normal "
+                             "priority)\n"
+                           : ": raising it to -10 needs root or CAP_SYS_NICE, so busy programs "
+                             "beside the run can make it drop frames (--priority 0 stops asking)"))
+      << live.output;
   EXPECT_TRUE(contains(live.output, "semantic pace: frames at each level: 0 pspnet.yaml ("))
       << live.output;
   std::ifstream in(dir / "live" / "stats.json");
@@ -698,6 +707,10 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   // On a stale mask, poses are solved on the judged map points first; each pose that set newer
   // matches aside set at least one aside.
   EXPECT_TRUE(masks["judged_points_first"].get<bool>());
+  EXPECT_TRUE(masks["jump_guard"].get<bool>());
+  EXPECT_TRUE(contains(live.output, " poses held at the motion model (jump guard on)\n"))
+      << live.output;
+  EXPECT_LE(masks["frames_pose_held"].get<int>(), masks["frames_on_stale_mask"].get<int>());
   EXPECT_TRUE(contains(live.output, "judged points first: on (")) << live.output;
   EXPECT_LE(masks["poses_judged_first"].get<int>(), stats["frames"].get<int>());
   EXPECT_GE(masks["unjudged_matches_set_aside"].get<int>(), masks["poses_judged_first"].get<int>());
@@ -715,6 +728,7 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   const Result deterministic = pspslam(run + (dir / "deterministic").string());
   ASSERT_EQ(deterministic.status, 0) << deterministic.output;
   EXPECT_FALSE(contains(deterministic.output, "live masks:")) << deterministic.output;
+  EXPECT_FALSE(contains(deterministic.output, "priority:")) << deterministic.output;
   std::ifstream in_deterministic(dir / "deterministic" / "stats.json");
   EXPECT_FALSE(nlohmann::json::parse(in_deterministic).contains("live_masks"));
 }
@@ -759,6 +773,12 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   ASSERT_EQ(live_arrivals.size(), static_cast<size_t>(processed));
   for (const std::string& value : live_arrivals) EXPECT_GT(std::stod(value), 0.0);
   EXPECT_EQ(live_scheduling["background_thread_nice"].get<int>(), 10);
+  // Tracking asks for nice -10; only root (or CAP_SYS_NICE) gets it, and the others are told.
+  if (geteuid() == 0) {
+    EXPECT_EQ(live_scheduling["tracking_nice"].get<int>(), -10);
+  } else {
+    EXPECT_GE(live_scheduling["tracking_nice"].get<int>(), 0);
+  }
   EXPECT_EQ(live_scheduling["opencv_threads"].get<int>(), 1);
   EXPECT_EQ(live_scheduling["local_ba_keyframes"].get<int>(), 10);
   EXPECT_EQ(realtime["arrival_to_pose_ms"]["count"].get<int>(), processed);
@@ -773,6 +793,7 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
   EXPECT_EQ(deterministic["arrival_to_pose_ms"]["count"].get<int>(), 0);
   EXPECT_EQ(arrival_column("deterministic"), std::vector<std::string>(30, ""));
   EXPECT_EQ(scheduling["background_thread_nice"].get<int>(), 0);
+  EXPECT_EQ(scheduling["tracking_nice"].get<int>(), getpriority(PRIO_PROCESS, 0));  // untouched
   EXPECT_EQ(scheduling["opencv_threads"].get<int>(), cv::getNumThreads());
   EXPECT_EQ(scheduling["local_ba_keyframes"].get<int>(), 0);
   // Every run keeps OpenBLAS on one thread (0: the BLAS is another one, with no threads to set).

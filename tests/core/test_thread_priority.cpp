@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <thread>
 
 #include "pspslam/core/thread_priority.h"
@@ -29,6 +31,39 @@ TEST(ThreadPriority, ZeroOrNegativeIncrementChangesNothing) {
     const int before = this_thread_nice();
     EXPECT_TRUE(lower_this_thread_priority(0));
     EXPECT_TRUE(lower_this_thread_priority(-5));
+    EXPECT_EQ(this_thread_nice(), before);
+  });
+  worker.join();
+}
+
+// Raising a priority is a privilege (root, CAP_SYS_NICE or RLIMIT_NICE): granted, the thread and
+// the threads it starts run at the raised value until the guard ends; refused, nothing changes.
+TEST(ThreadPriority, ARaisedPriorityIsInheritedAndUndoneOrRefusedCleanly) {
+  std::thread worker([] {
+    const int before = this_thread_nice();
+    int child_nice = 0;
+    bool raised = false;
+    {
+      const ScopedThreadPriority priority(before - 5);
+      raised = priority.raised();
+      std::thread child([&] { child_nice = this_thread_nice(); });
+      child.join();
+      EXPECT_EQ(this_thread_nice(), raised ? before - 5 : before);
+      EXPECT_EQ(child_nice, this_thread_nice());
+    }
+    EXPECT_EQ(this_thread_nice(), before);
+    if (geteuid() == 0) {
+      EXPECT_TRUE(raised);  // root may always raise
+    }
+  });
+  worker.join();
+}
+
+TEST(ThreadPriority, ANiceValueNotAboveTheThreadsOwnChangesNothing) {
+  std::thread worker([] {
+    const int before = this_thread_nice();
+    const ScopedThreadPriority same(before);
+    EXPECT_FALSE(same.raised());
     EXPECT_EQ(this_thread_nice(), before);
   });
   worker.join();

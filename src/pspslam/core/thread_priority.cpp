@@ -20,6 +20,17 @@ bool lower_this_thread_priority(int increment) {
          0;
 }
 
+ScopedThreadPriority::ScopedThreadPriority(int nice)
+    : previous_(this_thread_nice()), wanted_(nice) {
+  if (nice >= previous_) return;
+  raised_ = setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) == 0;
+}
+
+ScopedThreadPriority::~ScopedThreadPriority() {
+  // Going back down is always allowed.
+  if (raised_) setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), previous_);
+}
+
 bool use_single_threaded_blas() {
   using SetThreads = void (*)(int);
   void* const symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");

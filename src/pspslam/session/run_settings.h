@@ -13,6 +13,11 @@ namespace pspslam {
 // before the next one arrives, so the background work yields the core
 // (docs/decisions/realtime-nice.md).
 inline constexpr int kLiveBackgroundNice = 10;
+// Nice value a live run asks for its tracking thread (and the threads started from it, whose
+// background ones then lower theirs by kLiveBackgroundNice): beside busy programs of normal
+// priority on two cores, tracking at nice 0 gets too little of a core to keep up with 30 Hz
+// (docs/decisions/live-priority.md). Granted to root or with CAP_SYS_NICE only.
+inline constexpr int kLiveFramePathNice = -10;
 // Local BA window of live runs: the best 10 covisible keyframes. On two cores the whole covisible
 // set of a small room leaves local BA cut short, and the capped window keeps up. Offline runs keep
 // ORB-SLAM2's whole window, which gives the better final trajectory.

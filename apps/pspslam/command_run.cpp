@@ -113,7 +113,6 @@ struct RunFlags {
   std::string stale_masks = "homography";
   int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
   std::string mover_guard = "off";
-  std::string jump_guard = "on";
   std::string stale_geometry = "on";
   std::string late_mask_culling = "on";
   std::string judged_points_first = "on";
@@ -189,7 +188,6 @@ void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
   else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
     dynamic.smaller_model = shipped_smaller;
   system.tracker.mover_guard.enabled = flags.mover_guard == "on";
-  system.tracker.mover_guard.hold_jumps_on_stale_masks = flags.jump_guard == "on";
   dynamic.tighten_geometry = flags.stale_geometry == "on";
   dynamic.cull_with_late_masks = flags.late_mask_culling == "on";
   system.tracker.judged_points_first = flags.judged_points_first == "on";
@@ -474,13 +472,6 @@ void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
                   "experimental: when a frame's inliers drop and its pose jumps off the "
                   "constant-velocity prediction (tracking following a crowd), hold the "
                   "prediction for up to 3 frames")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--jump-guard", flags.jump_guard,
-                  "with --realtime and --late-mask-culling on: while the mask is more than 2 "
-                  "frames old, a pose that leaves the constant-velocity prediction faster than a "
-                  "camera moves (6 m/s, 6 rad/s) is held at the prediction for up to 3 frames, "
-                  "and no keyframe is made from it")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
 }

@@ -707,10 +707,9 @@ TEST(CliRun, LiveRunSaysWhatTheSemanticThreadSteppedDownTo) {
   // On a stale mask, poses are solved on the judged map points first; each pose that set newer
   // matches aside set at least one aside.
   EXPECT_TRUE(masks["judged_points_first"].get<bool>());
-  EXPECT_TRUE(masks["jump_guard"].get<bool>());
-  EXPECT_TRUE(contains(live.output, " poses held at the motion model (jump guard on)\n"))
-      << live.output;
-  EXPECT_LE(masks["frames_pose_held"].get<int>(), masks["frames_on_stale_mask"].get<int>());
+  // The mover guard is opt-in: no pose is held.
+  EXPECT_EQ(masks["frames_pose_held"].get<int>(), 0);
+  EXPECT_TRUE(contains(live.output, " 0 poses held at the motion model\n")) << live.output;
   EXPECT_TRUE(contains(live.output, "judged points first: on (")) << live.output;
   EXPECT_LE(masks["poses_judged_first"].get<int>(), stats["frames"].get<int>());
   EXPECT_GE(masks["unjudged_matches_set_aside"].get<int>(), masks["poses_judged_first"].get<int>());

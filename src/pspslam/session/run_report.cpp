@@ -64,21 +64,20 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
   if (!dynamic.realtime || !uses_semantics(dynamic.mode) || !dynamic.semantic_masks.empty())
     return nullptr;
   char line[768];
-  std::snprintf(
-      line, sizeof(line),
-      "live masks:   %zu frames on a mask older than %d frames; stale masks moved by "
-      "%s (%zu frames by the people's flow), %zu frames with the geometry test "
-      "tightened around them, %zu poses held at the motion model (jump guard %s)\n"
-      "              culling by exact masks only: %s (%zu frames judged by their own "
-      "late mask, %zu map points culled so); judged points first: %s (%zu poses set "
-      "%zu newer matches aside)\n",
-      stats.frames_on_stale_mask, stats.stale_mask_frames(),
-      dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography",
-      stats.frames_mask_moved_by_flow, stats.frames_geometry_tightened, stats.frames_pose_held,
-      input.options.system.tracker.mover_guard.hold_jumps_on_stale_masks ? "on" : "off",
-      dynamic.cull_with_late_masks ? "on" : "off", stats.late_frames_judged,
-      stats.culled_by_late_masks, input.options.system.tracker.judged_points_first ? "on" : "off",
-      stats.poses_judged_first, stats.unjudged_matches_set_aside);
+  std::snprintf(line, sizeof(line),
+                "live masks:   %zu frames on a mask older than %d frames; stale masks moved by "
+                "%s (%zu frames by the people's flow), %zu frames with the geometry test "
+                "tightened around them, %zu poses held at the motion model\n"
+                "              culling by exact masks only: %s (%zu frames judged by their own "
+                "late mask, %zu map points culled so); judged points first: %s (%zu poses set "
+                "%zu newer matches aside)\n",
+                stats.frames_on_stale_mask, stats.stale_mask_frames(),
+                dynamic.stale_masks == StaleMaskPolicy::flow ? "flow" : "homography",
+                stats.frames_mask_moved_by_flow, stats.frames_geometry_tightened,
+                stats.frames_pose_held, dynamic.cull_with_late_masks ? "on" : "off",
+                stats.late_frames_judged, stats.culled_by_late_masks,
+                input.options.system.tracker.judged_points_first ? "on" : "off",
+                stats.poses_judged_first, stats.unjudged_matches_set_aside);
   out << line;
   nlohmann::ordered_json json = {
       {"stale_after_frames", stats.stale_mask_frames()},
@@ -87,7 +86,6 @@ nlohmann::ordered_json report_live_masks(const RunReportInput& input, std::ostre
       {"frames_mask_moved_by_flow", stats.frames_mask_moved_by_flow},
       {"frames_geometry_tightened", stats.frames_geometry_tightened},
       {"frames_pose_held", stats.frames_pose_held},
-      {"jump_guard", input.options.system.tracker.mover_guard.hold_jumps_on_stale_masks},
       {"cull_with_late_masks", dynamic.cull_with_late_masks},
       {"late_frames_judged", stats.late_frames_judged},
       {"culled_by_late_masks", stats.culled_by_late_masks},

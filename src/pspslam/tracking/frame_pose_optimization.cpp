@@ -102,20 +102,6 @@ PoseOptimizationResult optimize_frame_pose_judged_first(
   return result;
 }
 
-int hold_frame_pose(Frame& frame, const Pose& T_camera_world, const PoseOptimizerOptions& options,
-                    FramePoseBuffers& buffers) {
-  frame.set_pose(T_camera_world);
-  gather_observations(frame, /*inliers_only=*/false, buffers);
-  classify_observations(frame.camera().pinhole, frame.camera().bf, T_camera_world,
-                        buffers.observations, options, buffers.agrees);
-  int inliers = 0;
-  for (size_t k = 0; k < buffers.observations.size(); ++k) {
-    frame.outlier[buffers.keypoint_of_observation[k]] = buffers.agrees[k] ? 0 : 1;
-    inliers += buffers.agrees[k];
-  }
-  return inliers;
-}
-
 RollingShutterPose refine_frame_rotation_rate(Frame& frame, const PoseOptimizerOptions& options,
                                               double sigma_rate, FramePoseBuffers& buffers) {
   const CameraModel& camera = frame.camera();

@@ -59,11 +59,6 @@ PoseOptimizationResult optimize_frame_pose_judged_first(Frame& frame,
                                                         const PosePrior* prior,
                                                         const JudgedPoints& judged, int& set_aside);
 
-// The frame set at `T_camera_world` (a pose held instead of the optimised one), each match
-// flagged inlier or outlier by its χ² there (classify_observations). Returns the inliers.
-int hold_frame_pose(Frame& frame, const Pose& T_camera_world, const PoseOptimizerOptions& options,
-                    FramePoseBuffers& buffers);
-
 // The frame's pose from its map point matches alone (PnP-RANSAC), for a frame whose last pose is
 // stale or unknown (recovery, a lost frame placed in a new map): set on the frame, the matches
 // outside the consensus dropped. False, the frame unchanged, when it fails.

@@ -61,7 +61,6 @@ Tracker::~Tracker() = default;
 
 TrackResult Tracker::track(Frame frame, std::optional<std::uint64_t> judged_through_frame) {
   std::lock_guard map_lock(map_.update_mutex());
-  on_stale_mask_ = judged_through_frame.has_value();
   judged_through_frame_ =
       options_.judged_points_first ? judged_through_frame : std::optional<std::uint64_t>();
   unjudged_matches_set_aside_ = 0;
@@ -380,20 +379,15 @@ bool Tracker::track_with_motion_model(Frame& frame) {
 }
 
 void Tracker::guard_against_movers(Frame& frame, TrackResult& result) {
-  if (!mover_guard_.watches(on_stale_mask_) || result.method != TrackingMethod::kMotionModel ||
-      !predicted_pose_ || !last_frame_) {
+  if (!options_.mover_guard.enabled) return;
+  if (result.method != TrackingMethod::kMotionModel || !predicted_pose_) {
     mover_guard_.reset();
     return;
   }
-  const GuardedFrame guarded{.inliers = result.num_inliers,
-                             .optimised = frame.T_camera_world(),
-                             .predicted = *predicted_pose_,
-                             .seconds = frame.timestamp() - last_frame_->timestamp(),
-                             .on_stale_mask = on_stale_mask_};
-  if (!mover_guard_.should_hold(guarded)) return;
-  result.num_inliers =
-      hold_frame_pose(frame, *predicted_pose_, options_.pose_optimizer, pose_buffers_);
-  result.pose_held = true;
+  if (mover_guard_.should_hold(result.num_inliers, frame.T_camera_world(), *predicted_pose_)) {
+    frame.set_pose(*predicted_pose_);
+    result.pose_held = true;
+  }
 }
 
 bool Tracker::track_reference_keyframe(Frame& frame, bool recovering) {
@@ -488,8 +482,7 @@ void Tracker::start_in_loaded_map() {
 }
 
 void Tracker::maybe_insert_keyframe(Frame& frame, TrackResult& result) {
-  // A held pose is a prediction, not a measurement: no map points are made from it.
-  if (options_.localization_only || result.pose_held) return;
+  if (options_.localization_only) return;
   KeyFrameEvidence evidence;
   evidence.frame_id = frame.id();
   evidence.last_keyframe_frame_id = last_keyframe_frame_id_;

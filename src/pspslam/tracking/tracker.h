@@ -58,8 +58,7 @@ struct TrackerOptions {
   // and keeps its poses. 0: never; the tracker stays lost until relocalised, and a young
   // monocular map is emptied and started again (TrackResult::restart_due).
   double new_map_after_seconds = 0.0;
-  // Hold the motion model's pose when the inliers slide onto a moving cluster, or when on a stale
-  // live mask the pose jumps faster than a camera moves (MoverGuard).
+  // Hold the motion model's pose when the inliers slide onto a moving cluster (MoverGuard).
   MoverGuardOptions mover_guard;
   // A frame given a judged_through_frame (a live frame on a stale mask) solves its pose on the
   // judged points first (optimize_frame_pose_judged_first); off: on every match
@@ -111,7 +110,7 @@ struct TrackResult {
   // the caller stops local mapping's work and calls Tracker::restart().
   bool restart_due = false;
   // The pose is the motion model's prediction: the optimised one followed a moving cluster
-  // (MoverGuard). No keyframe is made from the frame.
+  // (MoverGuard).
   bool pose_held = false;
   // Matches to points made since the frame given as judged_through_frame that the pose did not
   // use: they disagreed with the pose the judged points gave (TrackerOptions::judged_points_first).
@@ -150,7 +149,7 @@ class Tracker {
 
   // `judged_through_frame`: the map points made by this frame's keyframes and older ones have
   // been judged by an exact semantic mask, newer ones not yet (a live run's stale mask); see
-  // TrackerOptions::judged_points_first and MoverGuardOptions::hold_jumps_on_stale_masks.
+  // TrackerOptions::judged_points_first.
   TrackResult track(Frame frame, std::optional<std::uint64_t> judged_through_frame = std::nullopt);
 
   // Every tracked frame moved by the corrections mapping has since applied to the keyframes
@@ -236,7 +235,6 @@ class Tracker {
   // The constant-velocity prediction of the frame being tracked with the motion model.
   std::optional<Pose> predicted_pose_;
   MoverGuard mover_guard_;
-  bool on_stale_mask_ = false;                         // the frame being tracked's live mask
   std::optional<std::uint64_t> judged_through_frame_;  // of the frame being tracked
   int unjudged_matches_set_aside_ = 0;                 // by the frame being tracked
   std::optional<Pose> last_tracked_pose_;              // T_camera_world of the latest tracked frame

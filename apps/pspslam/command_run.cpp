@@ -254,13 +254,16 @@ std::unique_ptr<LiveViewer> start_viewer(const RunFlags& flags, const SystemOpti
   return viewer;
 }
 
+// Said only when the run asked for a raised priority: whether tracking has it (raised now, or
+// already as high), or why not.
 void report_priority(const ScopedThreadPriority& priority) {
   if (priority.wanted() >= 0) return;
-  if (priority.raised()) {
-    std::cout << "priority:     tracking at nice " << priority.wanted()
+  const int nice = this_thread_nice();
+  if (nice <= priority.wanted()) {
+    std::cout << "priority:     tracking at nice " << nice
               << " (above busy programs of normal priority)" << std::endl;
   } else {
-    std::cout << "priority:     tracking at nice " << this_thread_nice() << ": raising it to "
+    std::cout << "priority:     tracking at nice " << nice << ": raising it to "
               << priority.wanted()
               << " needs root or CAP_SYS_NICE, so busy programs beside the run can make it drop "
                  "frames (--priority 0 stops asking)"

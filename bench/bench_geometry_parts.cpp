@@ -6,7 +6,7 @@
 #include <random>
 
 #include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/geometry/test_scene.h"
+#include "support/geometry_test_scene.h"
 
 namespace {
 

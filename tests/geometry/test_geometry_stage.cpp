@@ -3,7 +3,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/yaml_section.h"
 #include "pspslam/geometry/geometry_stage.h"
-#include "pspslam/geometry/test_scene.h"
+#include "support/geometry_test_scene.h"
 
 namespace pspslam {
 namespace {

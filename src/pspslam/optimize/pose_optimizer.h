@@ -1,8 +1,7 @@
 #pragma once
 
 // Pose-only optimisation (motion-only bundle adjustment) of one RGB-D frame against known map
-// points, ORB-SLAM2 semantics. Called by tracking on every frame, so it must stay cheap
-// (bench/bench_optimize BM_OptimizePose/500: 500 observations, 20% outliers).
+// points, ORB-SLAM2 semantics. Called by tracking on every frame, so it must stay cheap.
 //
 // Call pattern (tracking):
 //   std::vector<PoseObservation> observations;           // one per matched map point

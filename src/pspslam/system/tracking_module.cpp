@@ -75,8 +75,9 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
   FrameReport report;
   const double cpu_start = thread_cpu_ms();
   const cv::Mat gray = grey_image(frame);
-  // 1-2. Flow and compensated homography to the previous frame (eq. 10-11), then the semantic
-  // mask: this frame's own (deterministic) or the newest one brought into it (live).
+  // 1. Flow and compensated homography to the previous frame (eq. 10-11), then
+  // 2. the semantic mask: this frame's own (deterministic) or the newest one brought into it
+  // (live). docs/architecture.md numbers the steps as here.
   const cv::Mat semantic_mask =
       dynamic_ ? dynamic_->begin_frame(frame, gray, report.dynamic) : cv::Mat();
 

@@ -1,4 +1,4 @@
-#include "pspslam/geometry/test_scene.h"
+#include "support/geometry_test_scene.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

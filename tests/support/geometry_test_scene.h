@@ -11,7 +11,7 @@
 namespace pspslam {
 
 // A small analytic RGB-D scene with ground-truth dynamic labels, used by the geometry module's
-// tests and its parameter sweeps (bench_geometry_test_scene): a room with static furniture, people
+// tests and its timing (bench/bench_geometry_parts.cpp): a room with static furniture, people
 // walking (label 15) and a box one person carries (label 100), seen by a moving camera. Depth
 // follows a Kinect-like noise model and is quantised to 1/5000 m, as in TUM/Bonn files. Labels use
 // the same convention as `pspslam synth` masks: 0 static, 15 person, 100 carried object.

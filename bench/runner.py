@@ -33,6 +33,39 @@ def log(message):
     print(f"[{time.strftime('%H:%M:%S')}] {message}", file=sys.stderr, flush=True)
 
 
+def add_common_arguments(command):
+    command.add_argument("--build", default=str(REPO / "build"),
+                         help="build folder with apps/pspslam (default: %(default)s)")
+    command.add_argument("--data", default=os.environ.get("PSPSLAM_DATA"),
+                         help="folder holding downloaded sequences (TUM, Bonn) by their official "
+                              "folder names (default: $PSPSLAM_DATA); cells not found there are "
+                              "listed as missing")
+    command.add_argument("--shared",
+                     default=os.environ.get("PSPSLAM_SHARED", str(REPO.parent / "shared")),
+                         help="the project's shared folder (default: $PSPSLAM_SHARED or ../shared)")
+    command.add_argument("--work", default=os.environ.get("PSPSLAM_BENCH_WORK", "/tmp/pspslam-bench"),
+                         help="folder for sequences, runs and results; shared by experiments "
+                              "(default: $PSPSLAM_BENCH_WORK or %(default)s)")
+    command.add_argument("--jobs", type=int, default=None,
+                         help="runs at a time in the local pool (default: 1 for an experiment "
+                              "marked exclusive, else the number of cores)")
+    command.add_argument("--scheduler", metavar="ADDRESS",
+                         help="run on this dask.distributed scheduler (e.g. tcp://HOST:8786) instead "
+                              "of the local pool; workers must see the build, data and --work at "
+                              "the same paths")
+    command.add_argument("--retries", type=int, default=2,
+                         help="times a failed run (or one whose worker died) is run again "
+                              "(default: %(default)s)")
+    command.add_argument("--results",
+                         help="file whose section is regenerated (default: the experiment's "
+                              "decision record for decision evidence, else docs/results.md)")
+    command.add_argument("--limit-frames", type=int, default=0, metavar="N",
+                         help="cap every run at N frames: a quick check of an experiment's "
+                              "definitions, kept apart from full runs (default: no cap)")
+    command.add_argument("--dry-run", action="store_true",
+                         help="list the runs and which have results, run nothing")
+
+
 def parse_arguments(argv):
     parser = argparse.ArgumentParser(prog="runner.py", description=__doc__.split("\n\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -48,37 +81,20 @@ def parse_arguments(argv):
                "The experiment file format: bench/experiments/README.md.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("experiment", help="experiment file (bench/experiments/NAME.toml)")
-    run.add_argument("--build", default=str(REPO / "build"),
-                     help="build folder with apps/pspslam (default: %(default)s)")
-    run.add_argument("--data", default=os.environ.get("PSPSLAM_DATA"),
-                     help="folder holding downloaded sequences (TUM, Bonn) by their official "
-                          "folder names (default: $PSPSLAM_DATA); cells not found there are "
-                          "listed as missing")
-    run.add_argument("--shared",
-                     default=os.environ.get("PSPSLAM_SHARED", str(REPO.parent / "shared")),
-                     help="the project's shared folder (default: $PSPSLAM_SHARED or ../shared)")
-    run.add_argument("--work", default=os.environ.get("PSPSLAM_BENCH_WORK", "/tmp/pspslam-bench"),
-                     help="folder for sequences, runs and results; shared by experiments "
-                          "(default: $PSPSLAM_BENCH_WORK or %(default)s)")
-    run.add_argument("--jobs", type=int, default=None,
-                     help="runs at a time in the local pool (default: 1 for an experiment "
-                          "marked exclusive, else the number of cores)")
-    run.add_argument("--scheduler", metavar="ADDRESS",
-                     help="run on this dask.distributed scheduler (e.g. tcp://HOST:8786) instead "
-                          "of the local pool; workers must see the build, data and --work at "
-                          "the same paths")
-    run.add_argument("--retries", type=int, default=2,
-                     help="times a failed run (or one whose worker died) is run again "
-                          "(default: %(default)s)")
-    run.add_argument("--results", default=str(REPO / "docs" / "results.md"),
-                     help="results file whose section is regenerated (default: %(default)s)")
-    run.add_argument("--limit-frames", type=int, default=0, metavar="N",
-                     help="cap every run at N frames: a quick check of an experiment's "
-                          "definitions, kept apart from full runs (default: no cap)")
     run.add_argument("--variants", help="comma-separated variants to run (default: all); the "
                                         "section then shows these only")
-    run.add_argument("--dry-run", action="store_true",
-                     help="list the runs and which have results, run nothing")
+    every = commands.add_parser(
+        "all", help="regenerate every current figure that needs no download, in one invocation",
+        description="Run every experiment of bench/experiments/ that needs no downloaded "
+                    "sequences and is no decision's evidence (those live in their records), at "
+                    "one clean commit on this machine: the others first, then the timing "
+                    "(exclusive) ones one run at a time with nothing beside them. Refuses a "
+                    "checkout with changes or a build of another commit.")
+    every.add_argument("--allow-dirty", action="store_true",
+                       help="run on a checkout with changes or a build of another commit (the "
+                            "sections then say so in their commit)")
+    for command in (run, every):
+        add_common_arguments(command)
     return parser, parser.parse_args(argv)
 
 
@@ -288,19 +304,24 @@ def build_commit(setup):
     source = build_source(setup.build) or REPO
     commit = subprocess.run(["git", "-C", str(source), "rev-parse", "--short=10", "HEAD"],
                             capture_output=True, text=True).stdout.strip()
-    return f"{commit} (checkout of {source})" if commit else "unknown"
+    return f"{commit} (of the checkout the build was configured from)" if commit else "unknown"
 
 
 def plural(count, word):
     return f"{count} {word}{'' if count == 1 else 's'}"
 
 
-def regenerate_command():
-    # The script itself, not "python3 script": its first line names the system interpreter,
-    # which has matplotlib and dask where another python3 may come first on PATH.
-    words = [os.path.relpath(Path(sys.argv[0]).resolve(), Path.cwd()), *sys.argv[1:]]
-    if "PSPSLAM_SHARED" in os.environ and "--shared" not in sys.argv:
-        words.insert(0, f"PSPSLAM_SHARED={os.environ['PSPSLAM_SHARED']}")
+def regenerate_command(args, experiment):
+    """The command that regenerates a section, as run from the repository's root: the runner
+    and the experiment by their repository paths, and only what changes the figures (where the
+    build, the shared folder and the work folder lie is the reader's own)."""
+    words = ["bench/runner.py", "run", experiment.path.resolve().relative_to(REPO).as_posix()]
+    if experiment.needs_download():
+        words += ["--data", "DIR"]
+    if getattr(args, "variants", None):
+        words += ["--variants", args.variants]
+    if args.limit_frames:
+        words += ["--limit-frames", str(args.limit_frames)]
     return " ".join(shlex.quote(word) for word in words)
 
 
@@ -320,27 +341,38 @@ def when_made(table):
             "start; ")
 
 
-def provenance(setup, executor, counts, loads, table):
-    return [f"Regenerate: `{regenerate_command()}`", "",
-            f"_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; build `{setup.build}` at "
-            f"commit {build_commit(setup)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
+def provenance(args, experiment, setup, executor, counts, loads, table):
+    return [f"Regenerate: `{regenerate_command(args, experiment)}`", "",
+            f"_{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; measured at commit "
+            f"{build_commit(setup)} (pspslam sha256 {setup.cli_sha256[:12]}); machine: "
             f"{cpu_model()}, {os.cpu_count()} cores; {when_made(table)}load average "
             f"{loads[0]:.1f} before, {loads[1]:.1f} after this invocation; "
             f"{plural(counts['runs'], 'run')} ({counts['new']} run now, {counts['reused']} "
             f"reused) on the {executor}._"]
 
 
+def results_file_of(args, experiment):
+    """Where a section goes: --results, else the experiment's decision record, else the current
+    figures."""
+    if args.results:
+        return Path(args.results).resolve()
+    if experiment.record:
+        return REPO / experiment.record
+    return REPO / "docs" / "results.md"
+
+
 def write_report(args, experiment, setup, table, executor_text, counts, loads):
     lines = report.tables(experiment, table)
-    results_file = Path(args.results).resolve()
+    results_file = results_file_of(args, experiment)
     image = results_file.parent / "results" / f"{experiment.name}.png"
     link = None
     if report.plot(experiment, table, image):
         link = os.path.relpath(image, results_file.parent)
     else:
         image.unlink(missing_ok=True)  # an older run's picture would not match the tables
-    text = report.section(experiment, lines, provenance(setup, executor_text, counts, loads, table),
-                          link)
+    text = report.section(
+        experiment, lines,
+        provenance(args, experiment, setup, executor_text, counts, loads, table), link)
     report.replace_section(results_file, experiment.name, text)
     log(f"wrote the '{experiment.name}' section of {results_file}")
 
@@ -356,12 +388,10 @@ def choose_jobs(parser, args, experiment):
     return args.jobs or os.cpu_count() or 1
 
 
-def main(argv=None):
-    parser, args = parse_arguments(argv)
-    experiment = load_experiment(parser, args)
-    setup = make_setup(parser, args)
+def run_experiment(parser, args, experiment, setup):
+    """Runs one experiment and writes its section; returns the number of failed runs, or None
+    for a dry run."""
     jobs = choose_jobs(parser, args, experiment)
-    setup.work.mkdir(parents=True, exist_ok=True)
     log(f"{experiment.name}: {plural(len(experiment.cells), 'cell')} × "
         f"{plural(len(experiment.variants), 'variant')} × {plural(experiment.repeats, 'run')}; "
         f"work in {setup.work}")
@@ -384,7 +414,7 @@ def main(argv=None):
         for job in all_jobs:
             state = "to run" if job in pending else "done"
             print(f"{state:7} {job['label']}  {job['key'][:12]}  {shlex.join(job['command'])}")
-        return 0
+        return None
     loads = [os.getloadavg()[0]]
     executor = (DaskCluster(args.scheduler, args.retries) if args.scheduler
                 else LocalPool(jobs, args.retries))
@@ -396,6 +426,58 @@ def main(argv=None):
     counts = {"runs": len(all_jobs), "new": len(pending) - failures,
               "reused": len(all_jobs) - len(pending)}
     write_report(args, experiment, setup, table, executor_text, counts, loads)
+    return failures
+
+
+def current_experiments():
+    """Every experiment `all` regenerates, the timing (exclusive) ones last: no download, no
+    decision record."""
+    chosen = []
+    for path in sorted((REPO / "bench" / "experiments").glob("*.toml")):
+        experiment = experiments.load(path)
+        if not experiment.needs_download() and experiment.record is None:
+            chosen.append(experiment)
+    return sorted(chosen, key=lambda e: e.exclusive)
+
+
+def require_clean_commit(parser, setup):
+    """`all` measures one commit: the checkout has no changes and the build is of its HEAD."""
+    changes = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain",
+                              "--untracked-files=no"], capture_output=True, text=True).stdout
+    if changes.strip():
+        parser.error("the checkout has changes: commit them first (or --allow-dirty)")
+    head = subprocess.run(["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+    built = build_commit(setup)
+    if not head or "-dirty" in built or not head.startswith(built.split(" ")[0]):
+        parser.error(f"the build is of commit {built}, the checkout at {head[:10]}: rebuild "
+                     "first (or --allow-dirty)")
+
+
+def run_all(parser, args, setup):
+    if not args.allow_dirty:
+        require_clean_commit(parser, setup)
+    chosen = current_experiments()
+    log("all: " + ", ".join(e.name + (" (alone)" if e.exclusive else "") for e in chosen))
+    failed = []
+    for experiment in chosen:
+        if run_experiment(parser, args, experiment, setup):
+            failed.append(experiment.name)
+    if failed:
+        log(f"runs failed in {', '.join(failed)}; run the same command again to retry them "
+            "(finished runs are kept)")
+        return 1
+    return 0
+
+
+def main(argv=None):
+    parser, args = parse_arguments(argv)
+    experiment = load_experiment(parser, args) if args.command == "run" else None
+    setup = make_setup(parser, args)
+    setup.work.mkdir(parents=True, exist_ok=True)
+    if args.command == "all":
+        return run_all(parser, args, setup)
+    failures = run_experiment(parser, args, experiment, setup)
     if failures:
         log(f"{failures} runs failed; their cells show it. Run the same command again to retry "
             "them (finished runs are kept)")

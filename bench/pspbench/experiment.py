@@ -77,6 +77,13 @@ class Experiment:
     keyframe_table: bool
     cells: list
     variants: list
+    # The decision record (docs/decisions/NAME.md) whose evidence this experiment is: its tables
+    # are regenerated there, not in docs/results.md, which holds the current figures only.
+    record: str | None = None
+
+    def needs_download(self):
+        """Whether a cell reads downloaded sequences (--data): TUM, Bonn."""
+        return any(cell.source == "data" for cell in self.cells)
 
     def mode_of(self, cell, variant):
         return variant.mode or cell.mode or self.mode
@@ -293,6 +300,9 @@ def load(path):
         metric=fields.get_choice("metric", METRICS, "online"), base=base, mode=mode,
         spread_variant=spread_variant, columns=dict(columns),
         keyframe_table=fields.get("keyframe_table", bool, False), cells=_read_cells(fields, kind),
-        variants=variants)
+        variants=variants, record=fields.get("record", str))
+    if experiment.record is not None and not (
+            experiment.record.startswith("docs/decisions/") and experiment.record.endswith(".md")):
+        raise fields.error("record", f"expected docs/decisions/NAME.md, got '{experiment.record}'")
     fields.reject_unknown()
     return experiment

@@ -34,7 +34,8 @@ BAD_FILES = [
     (TOP + "repeats = 0\n" + CELL, "repeats: must be at least 1, got 0"),
     (TOP + "colour = 1\n" + CELL,
      "colour: unknown field (known here: base, cells, columns, description, exclusive, "
-     "keyframe_table, kind, metric, mode, modes, repeats, spread_variant, title, variants)"),
+     "keyframe_table, kind, metric, mode, modes, record, repeats, spread_variant, title, "
+     "variants)"),
     (TOP.replace("'geometry'", "'fast'") + CELL,
      "modes[1]: 'fast' is not one of off, semantic, geometry, full, exhaustive"),
     (TOP.replace("base = 'off'", "base = 'nothing'") + CELL,

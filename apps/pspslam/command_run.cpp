@@ -39,6 +39,7 @@
 #include "pspslam/semantic/segmenter.h"
 #include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/semantic/semantic_delay.h"
+#include "pspslam/session/run_option_table.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_settings.h"
 #include "pspslam/session/sequence_runner.h"
@@ -87,6 +88,10 @@ OverlayClasses overlay_classes(const DynamicOptions& dynamic) {
 
 }  // namespace
 
+// The flags of `pspslam run`. Those that shape the System are declared once, with the Python
+// keywords, in session/run_option_table.h: registered from that table and gathered into
+// `settings` while parsing. The rest are what only a command-line run has: its input, outputs,
+// process-wide settings and viewer.
 struct RunFlags {
   std::string sequence;
   std::string camera;
@@ -97,42 +102,11 @@ struct RunFlags {
   std::string out = "pspslam_out";
   size_t max_frames = 0;
   size_t start_frame = 0;
-  bool no_local_mapping = false;
-  std::string dynamic = "auto";
-  std::string model;           // empty: the shipped model
-  std::string semantic_masks;  // empty: the network segments the frames
-  bool realtime = false;
   std::string preload = "auto";
-  int background_nice = -1;     // -1: kLiveBackgroundNice for live runs, else 0
   std::optional<int> priority;  // none: kLiveFramePathNice for live runs, else 0
   int opencv_threads = -1;      // -1: 1 for live runs, else OpenCV's default (all cores)
-  int mask_margin = 5;
-  int segment_every = 1;
-  std::string semantic_pace = "off";
-  std::string smaller_model;  // empty: the shipped smaller input when --model is the shipped one
-  std::string stale_masks = "homography";
-  int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
-  std::string mover_guard = "off";
-  std::string stale_geometry = "on";
-  std::string late_mask_culling = "on";
-  std::string judged_points_first = "on";
-  std::string semantic_delay;  // empty: none (fault injection)
-  std::uint32_t semantic_delay_seed = 1;
-  double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
-  bool due_keyframes = false;
-  int local_ba_keyframes = -1;  // -1: kLiveLocalBaKeyframes for live runs, else 0 (all)
-  double ba_tracking_factors = 0.0;
-  int local_ba_fixed_keyframes = 0;
-  std::vector<double> motion_prior;  // {σ_t mm, σ_r degrees}; empty: none
-  std::string vocabulary;            // empty: the shipped vocabulary
-  bool no_relocalization = false;
-  double new_map_after = -1.0;  // -1: kNewMapAfterSeconds, kLiveNewMapAfterSeconds for live runs
-  std::string loop_closing = "auto";
   std::string save_map;
-  std::string load_map;
-  bool localization = false;
   std::string blackout;
-  int cull_hits = 3;
   std::string export_map;
   std::string export_dense;
   std::string save_masks;
@@ -140,65 +114,25 @@ struct RunFlags {
   std::string viewer;  // [HOST:]PORT; empty: no viewer
   bool viewer_paused = false;
   int viewer_interval_ms = 250;
+  // The table's options: the words typed for each (in table order) and whether it was given.
+  std::vector<std::vector<std::string>> option_words =
+      std::vector<std::vector<std::string>>(run_option_table().size());
+  std::vector<CLI::Option*> option_given = std::vector<CLI::Option*>(run_option_table().size());
+  RunSettings settings;  // gathered while parsing
 };
 
-// A path the user typed (relative to the current folder); empty: the run's default.
-std::optional<std::filesystem::path> typed_path(const std::string& typed) {
-  if (typed.empty()) return std::nullopt;
-  return std::filesystem::path(typed);
-}
-
-// The flags that shape the System, as the library's RunSettings.
-RunSettings run_settings(const RunFlags& flags) {
+// The flags that shape the System, as the library's RunSettings: the table's defaults, each
+// flag given, and the checks across flags (Error naming them).
+RunSettings gather_settings(const RunFlags& flags) {
   RunSettings settings;
-  settings.mode = flags.dynamic;
-  settings.model = typed_path(flags.model);
-  settings.vocabulary = typed_path(flags.vocabulary);
-  settings.semantic_masks = typed_path(flags.semantic_masks);
-  settings.load_map = typed_path(flags.load_map);
-  settings.localization = flags.localization;
-  settings.realtime = flags.realtime;
-  settings.live_camera = !flags.camera.empty();
-  settings.local_mapping = !flags.no_local_mapping;
-  settings.relocalization = !flags.no_relocalization;
-  if (flags.new_map_after >= 0.0) settings.new_map_after = flags.new_map_after;
-  settings.loop_closing = flags.loop_closing;
-  settings.mask_margin = flags.mask_margin;
-  settings.segment_every = flags.segment_every;
-  settings.cull_hits = flags.cull_hits;
-  settings.keyframe_ratio = flags.keyframe_ratio;
-  settings.due_keyframes = flags.due_keyframes;
-  if (flags.local_ba_keyframes >= 0) settings.local_ba_keyframes = flags.local_ba_keyframes;
-  settings.ba_tracking_factors = flags.ba_tracking_factors;
-  settings.local_ba_fixed_keyframes = flags.local_ba_fixed_keyframes;
-  if (flags.background_nice >= 0) settings.background_nice = flags.background_nice;
-  if (flags.motion_prior.size() == 2)
-    settings.motion_prior = std::pair(flags.motion_prior[0], flags.motion_prior[1]);
-  return settings;
-}
-
-// The flags only `pspslam run` has (semantic pacing, stale masks, mover guard, fault injection);
-// the Python module keeps their defaults.
-void set_cli_only_options(const RunFlags& flags, SystemOptions& system) {
-  DynamicOptions& dynamic = system.dynamic;
-  dynamic.keep_pace = flags.semantic_pace == "on";
-  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
-  if (!flags.smaller_model.empty())
-    dynamic.smaller_model = flags.smaller_model;
-  else if (flags.model.empty() && std::filesystem::is_regular_file(shipped_smaller))
-    dynamic.smaller_model = shipped_smaller;
-  system.tracker.mover_guard.enabled = flags.mover_guard == "on";
-  dynamic.tighten_geometry = flags.stale_geometry == "on";
-  dynamic.cull_with_late_masks = flags.late_mask_culling == "on";
-  system.tracker.judged_points_first = flags.judged_points_first == "on";
-  dynamic.propagation.max_growth_px = flags.stale_mask_growth;
-  dynamic.stale_masks =
-      flags.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
-  if (!flags.semantic_delay.empty()) {
-    dynamic.semantic.injected_delay =
-        parse_semantic_delay(flags.semantic_delay, "--semantic-delay-ms");
-    dynamic.semantic.injected_delay.seed = flags.semantic_delay_seed;
+  const std::vector<RunOption>& table = run_option_table();
+  for (size_t i = 0; i < table.size(); ++i) {
+    if (flags.option_given[i] == nullptr || flags.option_given[i]->count() == 0) continue;
+    table[i].set(settings, parse_run_text(table[i], flags.option_words[i]));
   }
+  settings.live_camera = !flags.camera.empty();
+  check_run_settings(settings, SettingNames{});
+  return settings;
 }
 
 namespace {
@@ -239,7 +173,7 @@ std::unique_ptr<LiveViewer> start_viewer(const RunFlags& flags, const SystemOpti
   live.web_root = data_dir() / "web";
   live.interval = std::chrono::milliseconds(flags.viewer_interval_ms);
   live.start_paused = flags.viewer_paused;
-  live.realtime = flags.realtime;
+  live.realtime = flags.settings.realtime;
   live.classes = overlay_classes(system.dynamic);
   live.title = !flags.video.empty()   ? "video " + flags.video
                : flags.camera.empty() ? flags.sequence
@@ -290,8 +224,9 @@ int exit_status(RunOutcome outcome) {
 int run_slam(const RunFlags& flags, const GlobalOptions& global) {
   use_single_threaded_blas();  // in every run: its calls are small, its spinning workers are not
   RunOptions options = run_options(flags, global);
-  const RunSettings settings = run_settings(flags);
+  const RunSettings& settings = flags.settings;
   options.system = system_options(settings);
+  options.settings = effective_settings(settings, options.system);
   SystemOptions& system = options.system;
   // OpenCV's pool is process-wide: with one thread the network runs on the (lowered) semantic
   // thread alone instead of borrowing workers that compete with tracking at full priority.
@@ -299,15 +234,14 @@ int run_slam(const RunFlags& flags, const GlobalOptions& global) {
     cv::setNumThreads(flags.opencv_threads);
   else if (settings.live())
     cv::setNumThreads(1);
-  set_cli_only_options(flags, system);
 
   // A sequence opens in the runner, after the viewer has bound its address; a camera or video
   // opens first, so that a live source can set what the run waits for.
   std::optional<RunInput> live;
   if (flags.sequence.empty()) live = open_run_input(options);
-  // A camera keeps delivering while the run waits: a loop's global BA (seconds) would drop a
-  // second of frames, so a live run without --realtime waits for local mapping only.
-  if (!flags.realtime && live && live->source->live())
+  // A video from a camera index keeps delivering as a camera does (system_options() says so for
+  // --camera): without --realtime it waits for local mapping only.
+  if (!settings.realtime && live && live->source->live())
     system.back_end_wait = BackEndWait::local_mapping;
   std::unique_ptr<LiveViewer> viewer = start_viewer(flags, system);
   // Raised before the runner starts its threads (a recording's reader, the System's): they inherit
@@ -347,6 +281,11 @@ CLI::Option* add_input_options(CLI::App* app, const std::shared_ptr<RunFlags>& f
     if (!flags->video.empty() && !flags->sensor.empty() && flags->sensor != "monocular")
       throw CLI::ValidationError(
           "--video", "is monocular; --sensor " + flags->sensor + " needs a sequence folder");
+    try {
+      flags->settings = gather_settings(*flags);
+    } catch (const Error& e) {
+      throw CLI::ValidationError(e.what());
+    }
   });
   app->add_option("--config", flags->config,
                   "camera/system config YAML (default: SEQUENCE/config.yaml when it exists, "
@@ -369,30 +308,37 @@ CLI::Option* add_input_options(CLI::App* app, const std::shared_ptr<RunFlags>& f
       ->check(in_range(size_t{0}, size_t{1000000000}))
       ->needs(sequence)
       ->capture_default_str();
-  app->add_flag("--no-local-mapping", flags->no_local_mapping,
-                "track only: keyframes enter the map but are never refined (debugging)");
   return sequence;
 }
 
-// How dynamic content is found.
-void add_dynamic_options(CLI::App* app, RunFlags& flags) {
-  app->add_option("--dynamic", flags.dynamic,
-                  "dynamic-scene mode: off | semantic | geometry | full | exhaustive | auto "
-                  "(auto = full when the segmentation model loads, else geometry)")
-      ->check(CLI::IsMember({"off", "semantic", "geometry", "full", "exhaustive", "auto"}))
-      ->capture_default_str();
-  app->add_option("--model", flags.model,
-                  "segmentation metadata YAML (default: the shipped models/pspnet/pspnet.yaml)");
+// The options of the table (session/run_option_table.h), shared with the Python module: each
+// registered with its checks, its words kept for gather_settings().
+void add_table_options(CLI::App* app, RunFlags& flags, CLI::Option* sequence) {
+  const std::vector<RunOption>& table = run_option_table();
+  for (size_t i = 0; i < table.size(); ++i) {
+    const RunOption& option = table[i];
+    if (option.flag.empty()) continue;  // set otherwise (live: --camera)
+    if (option.kind == RunOptionKind::flag || option.kind == RunOptionKind::negated_flag) {
+      flags.option_given[i] = app->add_flag(option.flag, option.help);
+      continue;
+    }
+    CLI::Option* added = app->add_option(option.flag, flags.option_words[i], option.help);
+    added->expected(option.kind == RunOptionKind::real_pair ? 2 : 1);
+    added->check(
+        CLI::Validator([&option](std::string& word) { return run_text_problem(option, {word}); },
+                       option.value_name));
+    if (const std::string shown = option.value_text(RunSettings{}); !shown.empty())
+      added->default_str(shown);
+    flags.option_given[i] = added;
+  }
+  // A folder of masks matches a sequence's images by name.
+  flags
+      .option_given[static_cast<size_t>(find_run_option_by_flag("--semantic-masks") - table.data())]
+      ->needs(sequence);
 }
 
 // Real-time runs: how frames are fed and how the threads share the cores.
 void add_live_options(CLI::App* app, RunFlags& flags) {
-  app->add_flag("--realtime", flags.realtime,
-                "feed frames at the sequence's rate (late frames are dropped) and never wait for "
-                "segmentation or the back end: use the newest mask, warped into the frame "
-                "(default: deterministic, each frame waits for its mask and for local mapping, "
-                "loop closing and any global BA to finish the previous keyframe; a camera waits "
-                "for local mapping only)");
   app->add_option("--preload", flags.preload,
                   "with --realtime on a recording: on = decode every frame before the replay "
                   "starts, so that no image decoding shares the cores with the run (a camera "
@@ -400,13 +346,6 @@ void add_live_options(CLI::App* app, RunFlags& flags) {
                   "on a reader thread, auto = on up to 2 GiB of decoded frames")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  app->add_option("--background-nice", flags.background_nice,
-                  "scheduling priority given up by the semantic, local mapping and loop closing "
-                  "threads below tracking's (nice increment, 0-19) so that tracking gets a core "
-                  "when a frame arrives (default: " +
-                      std::to_string(kLiveBackgroundNice) +
-                      " with --realtime or --camera, 0 otherwise)")
-      ->check(in_range(0, 19));
   app->add_option("--priority", flags.priority,
                   "nice value asked for tracking and the threads it starts, so that it keeps up "
                   "with the camera beside busy programs (needs root or CAP_SYS_NICE; without, "
@@ -421,167 +360,10 @@ void add_live_options(CLI::App* app, RunFlags& flags) {
       ->check(in_range(0, 256));
 }
 
-// How often the network runs and how the frames between use an older mask.
-void add_stale_mask_options(CLI::App* app, RunFlags& flags) {
-  app->add_option("--segment-every", flags.segment_every,
-                  "segment every n-th frame; the frames between use the newest mask, moved "
-                  "with the camera by the frame-to-frame homographies")
-      ->check(in_range(1, 30))
-      ->capture_default_str();
-  app->add_option("--semantic-pace", flags.semantic_pace,
-                  "with --realtime: when segmentation falls behind the camera, step down by "
-                  "itself to the smaller network input (--smaller-model), then to segmenting "
-                  "every 2nd or 3rd frame, and back up when there is room (off: one network on "
-                  "every frame it can take)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--smaller-model", flags.smaller_model,
-                  "the smaller segmentation model --semantic-pace steps down to (default: the "
-                  "shipped models/pspnet/pspnet_288x192.yaml when --model is the shipped one, "
-                  "else none: only sparser frames)")
-      ->check(CLI::ExistingFile);
-  app->add_option("--stale-masks", flags.stale_masks,
-                  "with --realtime, how an older mask is brought into the frame: flow = each "
-                  "person moves by the optical flow inside it and the mask grows with its age, "
-                  "and keypoints near a mask more than 2 frames old get the geometry test "
-                  "(experimental: it can leave a crowd too few static keypoints); homography = "
-                  "moved with the camera only")
-      ->check(CLI::IsMember({"flow", "homography"}))
-      ->capture_default_str();
-  app->add_option("--stale-mask-growth", flags.stale_mask_growth,
-                  "with --stale-masks flow: the most pixels a moved mask grows by for its age")
-      ->check(in_range(0, 200))
-      ->capture_default_str();
-  app->add_option("--stale-geometry", flags.stale_geometry,
-                  "with --realtime and --stale-masks flow: while the mask is more than 2 frames "
-                  "old, every keypoint in a band around it gets the multi-view geometry test")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--late-mask-culling", flags.late_mask_culling,
-                  "with --realtime: a mask that arrives after its frame was tracked still judges "
-                  "that frame; map points the frame saw on its people count towards their "
-                  "culling, and a mask more than 2 frames old culls nothing (off: the newest "
-                  "mask culls, however old)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--judged-points-first", flags.judged_points_first,
-                  "with --realtime and --late-mask-culling on: while the mask is more than 2 "
-                  "frames old, a frame's pose is solved on the map points an exact mask has "
-                  "judged first, and newer points count only where they agree with it (off: "
-                  "every match alike, which lets a crowd the stale mask missed carry the pose)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--mover-guard", flags.mover_guard,
-                  "experimental: when a frame's inliers drop and its pose jumps off the "
-                  "constant-velocity prediction (tracking following a crowd), hold the "
-                  "prediction for up to 3 frames")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-}
-
-// Where the semantic masks come from (the network, slowed down on purpose, or a folder) and
-// how far they are grown.
-void add_mask_source_options(CLI::App* app, RunFlags& flags, CLI::Option* sequence) {
-  CLI::Option* semantic_delay =
-      app->add_option("--semantic-delay-ms", flags.semantic_delay,
-                      "fault injection: MS or random:MIN:MAX milliseconds of extra wait after each "
-                      "segmentation, as if the network were that much slower (reproduces a "
-                      "network that falls behind the camera)")
-          ->check(CLI::Validator(
-              [](std::string& value) {
-                try {
-                  parse_semantic_delay(value, "--semantic-delay-ms");
-                  return std::string();
-                } catch (const Error& e) {
-                  return std::string(e.what());
-                }
-              },
-              "MS|random:MIN:MAX"));
-  app->add_option("--semantic-delay-seed", flags.semantic_delay_seed,
-                  "seed of the random:MIN:MAX delays (the same seed draws the same delays)")
-      ->needs(semantic_delay)
-      ->capture_default_str();
-  app->add_option("--semantic-masks", flags.semantic_masks,
-                  "read each frame's semantic mask from this folder instead of running the "
-                  "network: DIR/<colour image name>.png, 8-bit, non-zero = dynamic (what "
-                  "--save-masks writes; a synth sequence's mask/ folder); grown by --mask-margin")
-      ->check(CLI::ExistingDirectory)
-      ->needs(sequence);
-  app->add_option("--mask-margin", flags.mask_margin,
-                  "dilation of the semantic dynamic mask (pixels)")
-      ->check(in_range(0, 100))
-      ->capture_default_str();
-}
-
-// When a frame becomes a keyframe, how far local BA reaches and how a frame's pose is
-// optimised.
-void add_keyframe_options(CLI::App* app, RunFlags& flags) {
-  app->add_option("--keyframe-ratio", flags.keyframe_ratio,
-                  "a frame becomes a keyframe when it tracks fewer than this share of its "
-                  "reference keyframe's points (ORB-SLAM2: 0.75; higher = denser keyframes)")
-      ->check(in_range(0.01, 1.0))
-      ->capture_default_str();
-  app->add_option("--local-ba-keyframes", flags.local_ba_keyframes,
-                  "local BA optimises the new keyframe and at most this many of its best "
-                  "covisible keyframes; 0 = all of them, as ORB-SLAM2 (default: " +
-                      std::to_string(kLiveLocalBaKeyframes) +
-                      " with --realtime or --camera, so that local BA keeps up on two cores; 0 "
-                      "otherwise)")
-      ->check(in_range(0, 1000));
-  app->add_option("--local-ba-fixed-keyframes", flags.local_ba_fixed_keyframes,
-                  "of the keyframes held fixed around the local BA window (those that see its "
-                  "points), keep the ones that see the most of them; 0 = all, as ORB-SLAM2 "
-                  "(bounds local BA where a revisited room has many)")
-      ->check(in_range(0, 1000))
-      ->capture_default_str();
-  app->add_option("--ba-tracking-factors", flags.ba_tracking_factors,
-                  "WEIGHT: local BA also keeps each keyframe's pose relative to the keyframe "
-                  "before it as tracking measured it, weighted by WEIGHT times the information "
-                  "of its pose-only optimisation (0 = off, ORB-SLAM2's BA)")
-      ->check(in_range(0.0, 1e6))
-      ->capture_default_str();
-  app->add_flag("--due-keyframes", flags.due_keyframes,
-                "also make a keyframe once a second has passed since the last one, whatever "
-                "--keyframe-ratio says (keeps keyframes dense on a camera that keeps exploring; "
-                "off by default: docs/decisions/due-keyframes.md)");
-  app->add_option("--motion-prior", flags.motion_prior,
-                  "MM DEG: optimise each frame tracked with the motion model with its "
-                  "constant-velocity prediction as a prior of these σs (translation mm, rotation "
-                  "degrees; default: no prior; it lowers the jitter, not the ATE)")
-      ->expected(2)
-      ->check(in_range(1e-3, 1e3));
-}
-
-// The map: vocabulary, relocalisation, loop closing, saved maps, forced tracking loss and
-// culling of dynamic points.
+// The map file written at the end, and forced tracking loss.
 void add_map_options(CLI::App* app, RunFlags& flags) {
-  app->add_option("--vocabulary", flags.vocabulary,
-                  "ORB bag-of-words vocabulary for relocalisation and loop closing (default: the "
-                  "shipped models/vocabulary/orb_k10_l5.pspvoc)");
-  app->add_flag("--no-relocalization", flags.no_relocalization,
-                "do not relocalise when tracking is lost (and do not load the vocabulary)");
-  app->add_option("--new-map-after", flags.new_map_after,
-                  "SECONDS lost, with relocalisation failing in every map, before tracking starts "
-                  "a new map in the atlas; loop closing merges it when a place is recognised "
-                  "across the two (0: never; the run stays lost until relocalised; default: " +
-                      fmt::format("{:g} s, {:g} s for live runs", kNewMapAfterSeconds,
-                                  kLiveNewMapAfterSeconds) +
-                      ")")
-      ->check(in_range(0.0, 3600.0));
-  app->add_option("--loop-closing", flags.loop_closing,
-                  "loop closing thread (detection, essential-graph correction, global BA); auto = "
-                  "on when the vocabulary file exists")
-      ->check(CLI::IsMember({"on", "off", "auto"}))
-      ->capture_default_str();
   app->add_option("--save-map", flags.save_map,
                   "write the final map to this file (binary, see docs/place_recognition.md)");
-  CLI::Option* load_map =
-      app->add_option("--load-map", flags.load_map,
-                      "start from this saved map: the first frame is relocalised in it")
-          ->check(CLI::ExistingFile);
-  app->add_flag("--localization", flags.localization,
-                "localisation only (needs --load-map): track in the map, never add to it")
-      ->needs(load_map);
   app->add_option("--blackout", flags.blackout,
                   "FROM:COUNT: feed frames FROM..FROM+COUNT-1 as black images without depth "
                   "(tracking is lost for real; tests relocalisation)")
@@ -595,10 +377,6 @@ void add_map_options(CLI::App* app, RunFlags& flags) {
             }
           },
           "FROM:COUNT"));
-  app->add_option("--cull-hits", flags.cull_hits,
-                  "erase a map point after it lay on dynamic pixels in this many frames")
-      ->check(in_range(1, 1000))
-      ->capture_default_str();
 }
 
 // Optional outputs beside the trajectory files: point clouds, masks and overlays.
@@ -649,11 +427,8 @@ Command add_run_command(CLI::App& root) {
       "OUT/stats.json and OUT/run_config.yaml (the config used). With ground truth, prints ATE.");
   auto flags = std::make_shared<RunFlags>();
   CLI::Option* sequence = add_input_options(app, flags);
-  add_dynamic_options(app, *flags);
+  add_table_options(app, *flags, sequence);
   add_live_options(app, *flags);
-  add_stale_mask_options(app, *flags);
-  add_mask_source_options(app, *flags, sequence);
-  add_keyframe_options(app, *flags);
   add_map_options(app, *flags);
   add_output_options(app, *flags);
   add_viewer_options(app, *flags);

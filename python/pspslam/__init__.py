@@ -23,12 +23,13 @@ from ._pspslam import (  # noqa: F401
     data_dir,
     read_trajectory,
     rpe,
+    run_options,
     write_trajectory,
 )
 
 __all__ = [
     "FATES", "Error", "Frame", "Result", "Sequence", "System", "ate", "data_dir",
-    "read_sequence", "read_trajectory", "rpe", "track_frames", "write_trajectory",
+    "read_sequence", "read_trajectory", "rpe", "run_options", "track_frames", "write_trajectory",
 ]
 
 

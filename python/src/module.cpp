@@ -20,6 +20,7 @@
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/core/version.h"
 #include "pspslam/io/sequence_setup.h"
+#include "pspslam/session/run_option_table.h"
 #include "python_system.h"
 #include "sequence_reader.h"
 #include "system_options.h"
@@ -57,70 +58,80 @@ std::filesystem::path path_value(const py::handle& value, const std::string& key
   return value.cast<std::filesystem::path>();
 }
 
-// Stores one keyword option into RunSettings, checking its type.
-using OptionSetter = void (*)(RunSettings&, const py::handle&, const std::string&);
-
-template <auto member, typename T>
-void set_value(RunSettings& settings, const py::handle& value, const std::string& keyword) {
-  constexpr const char* expected = std::is_same_v<T, bool>          ? "a bool"
-                                   : std::is_same_v<T, int>         ? "an int"
-                                   : std::is_same_v<T, double>      ? "a float"
-                                   : std::is_same_v<T, std::string> ? "a str"
-                                                                    : "(millimetres, degrees)";
-  settings.*member = keyword_value<T>(value, keyword, expected);
+// A keyword's value as the table's kind wants it (TypeError naming the keyword otherwise), with
+// the text Python prints for each number (the messages quote it, as the CLI quotes what was
+// typed).
+std::pair<RunValue, std::vector<std::string>> keyword_run_value(const RunOption& option,
+                                                                const py::handle& value) {
+  const std::string& keyword = option.keyword;
+  switch (option.kind) {
+    case RunOptionKind::flag:
+    case RunOptionKind::negated_flag:
+      return {keyword_value<bool>(value, keyword, "a bool"), {}};
+    case RunOptionKind::integer:
+      return {keyword_value<long long>(value, keyword, "an int"), {py::str(value)}};
+    case RunOptionKind::real:
+      return {keyword_value<double>(value, keyword, "a float"), {py::str(value)}};
+    case RunOptionKind::real_pair: {
+      const auto pair =
+          keyword_value<std::pair<double, double>>(value, keyword, "(millimetres, degrees)");
+      return {pair, {py::str(py::cast(pair.first)), py::str(py::cast(pair.second))}};
+    }
+    case RunOptionKind::choice:
+    case RunOptionKind::text:
+      return {keyword_value<std::string>(value, keyword, "a str"), {}};
+    case RunOptionKind::path:
+      return {path_value(value, keyword).string(), {}};
+  }
+  throw py::type_error(keyword + ": not an option");
 }
 
-template <auto member>
-void set_path(RunSettings& settings, const py::handle& value, const std::string& keyword) {
-  settings.*member = path_value(value, keyword);
+void set_keyword(RunSettings& settings, const std::string& key, const py::handle& value) {
+  const RunOption* option = find_run_option_by_keyword(key);
+  if (option == nullptr) {
+    std::string names;
+    for (const RunOption& entry : run_option_table()) {
+      if (entry.keyword == "mode") continue;  // System's second argument
+      names += (names.empty() ? "" : ", ") + entry.keyword;
+    }
+    throw py::type_error("System: unexpected keyword '" + key + "' (the run options: " + names +
+                         ")");
+  }
+  const auto [run_value, shown] = keyword_run_value(*option, value);
+  if (const std::string problem = run_value_problem(*option, run_value, shown); !problem.empty())
+    throw py::value_error(key + ": " + problem);
+  option->set(settings, run_value);
 }
 
-// The `pspslam run` flags as keywords: `--mask-margin 3` is mask_margin=3, `--no-local-mapping`
-// is local_mapping=False, `--no-relocalization` is relocalization=False.
-const std::vector<std::pair<std::string, OptionSetter>>& run_options() {
-  static const std::vector<std::pair<std::string, OptionSetter>> options = {
-      {"model", &set_path<&RunSettings::model>},
-      {"vocabulary", &set_path<&RunSettings::vocabulary>},
-      {"semantic_masks", &set_path<&RunSettings::semantic_masks>},
-      {"load_map", &set_path<&RunSettings::load_map>},
-      {"localization", &set_value<&RunSettings::localization, bool>},
-      {"realtime", &set_value<&RunSettings::realtime, bool>},
-      {"local_mapping", &set_value<&RunSettings::local_mapping, bool>},
-      {"relocalization", &set_value<&RunSettings::relocalization, bool>},
-      {"new_map_after", &set_value<&RunSettings::new_map_after, double>},
-      {"loop_closing", &set_value<&RunSettings::loop_closing, std::string>},
-      {"mask_margin", &set_value<&RunSettings::mask_margin, int>},
-      {"segment_every", &set_value<&RunSettings::segment_every, int>},
-      {"cull_hits", &set_value<&RunSettings::cull_hits, int>},
-      {"keyframe_ratio", &set_value<&RunSettings::keyframe_ratio, double>},
-      {"due_keyframes", &set_value<&RunSettings::due_keyframes, bool>},
-      {"local_ba_keyframes", &set_value<&RunSettings::local_ba_keyframes, int>},
-      {"background_nice", &set_value<&RunSettings::background_nice, int>},
-      {"motion_prior", &set_value<&RunSettings::motion_prior, std::pair<double, double>>},
-  };
-  return options;
-}
-
+// The `pspslam run` flags as keywords (session/run_option_table.h): `--mask-margin 3` is
+// mask_margin=3, `--no-local-mapping` is local_mapping=False, `--dynamic` is mode.
 RunSettings run_settings(const std::string& mode, const py::kwargs& keywords) {
   RunSettings settings;
-  settings.mode = mode;
-  for (const auto& [key_object, value] : keywords) {
-    const std::string key = py::str(key_object);
-    const auto& options = run_options();
-    const auto option = std::find_if(options.begin(), options.end(),
-                                     [&](const auto& entry) { return entry.first == key; });
-    if (option == options.end()) {
-      std::string names;
-      for (const auto& entry : options) {
-        if (!names.empty()) names += ", ";
-        names += entry.first;
-      }
-      throw py::type_error("System: unexpected keyword '" + key + "' (the run options: " + names +
-                           ")");
-    }
-    option->second(settings, value, key);
-  }
+  set_keyword(settings, "mode", py::str(mode));
+  for (const auto& [key_object, value] : keywords)
+    set_keyword(settings, py::str(key_object), value);
   return settings;
+}
+
+// The table as Python data: what each keyword is, its flag, range or choices and default.
+py::list run_option_list() {
+  py::list options;
+  const RunSettings defaults;
+  for (const RunOption& option : run_option_table()) {
+    py::dict entry;
+    entry["keyword"] = option.keyword;
+    entry["flag"] = option.flag.empty() ? py::object(py::none()) : py::object(py::str(option.flag));
+    static constexpr const char* kinds[] = {"flag",   "negated_flag", "integer", "real",
+                                            "choice", "text",         "path",    "real_pair"};
+    entry["kind"] = kinds[static_cast<int>(option.kind)];
+    entry["low"] = option.low;
+    entry["high"] = option.high;
+    entry["choices"] = option.choices;
+    entry["default"] = option.value_text(defaults);
+    entry["help"] = option.help;
+    options.append(entry);
+  }
+  return options;
 }
 
 // The config argument: a YAML file, a dict of the same keys, or a sequence (its config as
@@ -244,7 +255,7 @@ void register_result(py::module_& m) {
 
 void register_system(py::module_& m) {
   py::class_<PySystem>(m, "System")
-      .def(py::init(&make_system), py::arg("config"), py::arg("mode") = "full",
+      .def(py::init(&make_system), py::arg("config"), py::arg("mode") = "auto",
            py::arg("sensor") = py::none(), py::arg("keypoints") = false)
       .def(
           "make_frame",
@@ -271,6 +282,15 @@ void register_system(py::module_& m) {
       .def("keyframe_poses", &PySystem::keyframe_trajectory)
       .def("save_map", &PySystem::save_map, py::arg("path"))
       .def_property_readonly("mode", &PySystem::dynamic_mode)
+      .def_property_readonly(
+          "settings",
+          [](const PySystem& s) {
+            py::dict settings;
+            for (const auto& [keyword, value] : s.settings()) settings[py::str(keyword)] = value;
+            return settings;
+          },
+          "every run setting the System got, the run's own defaults resolved, as text: what "
+          "`pspslam run` writes to stats.json \"settings\"")
       .def_property_readonly("sensor",
                              [](const PySystem& s) { return to_string(s.config().camera.type); })
       .def_property_readonly("image_size", [](const PySystem& s) {
@@ -319,6 +339,9 @@ PYBIND11_MODULE(_pspslam, m) {
   m.attr("FATES") = py::make_tuple("tracked", "unmatched", "semantic", "geometry");
   m.attr("__version__") = version_string();
   m.def("data_dir", &data_dir, "Where the shipped models, vocabulary and configs are.");
+  m.def("run_options", &run_option_list,
+        "The System's keyword options: keyword, the `pspslam run` flag, kind, range or choices, "
+        "default (as text; empty: the run's own) and help.");
   register_frame(m);
   register_result(m);
   register_system(m);

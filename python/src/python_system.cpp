@@ -10,6 +10,7 @@
 #include "pspslam/core/thread_priority.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
+#include "pspslam/session/run_option_table.h"
 #include "pspslam/system/frame_builder.h"
 #include "sequence_reader.h"
 
@@ -69,7 +70,8 @@ PySystem::PySystem(SystemConfig config, std::string config_name, const RunSettin
                    bool keypoints)
     : config_(std::move(config)),
       config_name_(std::move(config_name)),
-      options_(checked_system_options(settings)) {
+      options_(checked_system_options(settings)),
+      settings_(effective_settings(settings, options_)) {
   // As `pspslam run`: the linear algebra calls are small, a BLAS's spinning workers are not.
   use_single_threaded_blas();
   apply_sensor_limits(config_.camera.type, options_);

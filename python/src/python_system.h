@@ -9,6 +9,8 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pspslam/config/config.h"
 #include "pspslam/io/input_frame.h"
@@ -57,6 +59,8 @@ class PySystem {
   const SystemConfig& config() const { return config_; }
   const SystemOptions& options() const { return options_; }
   std::string dynamic_mode() const { return to_string(options_.dynamic.mode); }
+  // Every run setting the System got, as `pspslam run` reports them in stats.json "settings".
+  const std::vector<std::pair<std::string, std::string>>& settings() const { return settings_; }
 
  private:
   // Holds the system for one call; a second thread gets RuntimeError instead of a race.
@@ -67,6 +71,7 @@ class PySystem {
   SystemConfig config_;
   std::string config_name_;
   SystemOptions options_;
+  std::vector<std::pair<std::string, std::string>> settings_;
   std::unique_ptr<System> system_;
   std::mutex busy_;
   bool shut_down_ = false;

@@ -5,10 +5,10 @@
 
 namespace pspslam::python {
 
-// The SystemOptions `pspslam run` makes from the same settings (session/run_settings.h), for a
-// recorded sequence: Python feeds recorded or its own frames, never a live camera. Deterministic
-// unless `realtime`. Raises ValueError naming the keyword for a value the CLI would refuse,
-// pspslam.Error for a model that does not load.
+// The SystemOptions `pspslam run` makes from the same settings (session/run_settings.h):
+// deterministic unless `realtime` or `live` (frames from a live source as they arrive, as
+// `run --camera`). Each keyword's value was checked as it was read (run_option_table.h); raises
+// ValueError for settings that do not go together, pspslam.Error for a model that does not load.
 SystemOptions checked_system_options(const RunSettings& settings);
 
 }  // namespace pspslam::python

@@ -2,11 +2,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "pspslam/core/error.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/session/frame_log.h"
+#include "pspslam/session/run_option_table.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_settings.h"
 #include "pspslam/session/run_statistics.h"
@@ -219,6 +221,62 @@ TEST(RunSettings, LiveRunsYieldTheCoreAndCapLocalBa) {
   EXPECT_EQ(camera.background_thread_nice, 3);
   EXPECT_EQ(camera.local_ba_keyframes, kLiveLocalBaKeyframes);
   EXPECT_FALSE(camera.dynamic.realtime);
+}
+
+TEST(RunSettings, ALiveSourceWaitsForLocalMappingOnlyAndEveryRunGetsTheLiveMaskPolicies) {
+  RunSettings settings;
+  settings.mode = "off";
+  const SystemOptions offline = system_options(settings);
+  // Acting in live runs only, so the same for every run, whichever front end made it.
+  EXPECT_TRUE(offline.dynamic.cull_with_late_masks);
+  EXPECT_TRUE(offline.tracker.judged_points_first);
+  EXPECT_TRUE(offline.dynamic.tighten_geometry);
+  EXPECT_FALSE(offline.dynamic.keep_pace);
+  EXPECT_EQ(offline.dynamic.stale_masks, StaleMaskPolicy::homography);
+  settings.live_camera = true;
+  EXPECT_EQ(system_options(settings).back_end_wait, BackEndWait::local_mapping);
+  settings.realtime = true;
+  EXPECT_EQ(system_options(settings).back_end_wait, BackEndWait::none);
+  settings.late_mask_culling = "off";
+  settings.semantic_delay_ms = "random:10:20";
+  settings.semantic_delay_seed = 7;
+  const SystemOptions changed = system_options(settings);
+  EXPECT_FALSE(changed.dynamic.cull_with_late_masks);
+  EXPECT_EQ(changed.dynamic.semantic.injected_delay, (SemanticDelay{10, 20, 7}));
+}
+
+TEST(RunOptionTable, FlagsAndKeywordsAreUniqueAndBadValuesAreToldOnce) {
+  std::set<std::string> flags;
+  std::set<std::string> keywords;
+  for (const RunOption& option : run_option_table()) {
+    if (!option.flag.empty()) {
+      EXPECT_TRUE(flags.insert(option.flag).second) << option.flag;
+    }
+    EXPECT_TRUE(keywords.insert(option.keyword).second) << option.keyword;
+  }
+  const RunOption& margin = *find_run_option_by_flag("--mask-margin");
+  EXPECT_EQ(margin.keyword, "mask_margin");
+  EXPECT_EQ(run_text_problem(margin, {"101"}), "must be an integer in [0, 100], got '101'");
+  EXPECT_EQ(run_text_problem(margin, {"2.5"}), "must be an integer in [0, 100], got '2.5'");
+  EXPECT_EQ(run_value_problem(margin, 101LL, {"101"}), "must be an integer in [0, 100], got '101'");
+  EXPECT_EQ(run_text_problem(margin, {"100"}), "");
+  const RunOption& ratio = *find_run_option_by_keyword("keyframe_ratio");
+  EXPECT_EQ(run_text_problem(ratio, {"0"}), "must be a number in [0.01, 1], got '0'");
+  const RunOption& loops = *find_run_option_by_keyword("loop_closing");
+  EXPECT_EQ(run_text_problem(loops, {"maybe"}), "must be one of on | off | auto, got 'maybe'");
+  const RunOption& prior = *find_run_option_by_flag("--motion-prior");
+  EXPECT_EQ(run_value_problem(prior, std::pair(1.0, 5000.0), {"1.0", "5000.0"}),
+            "must be a number in [0.001, 1000], got '5000.0'");
+  RunSettings settings;
+  prior.set(settings, parse_run_text(prior, {"2", "0.5"}));
+  EXPECT_EQ(settings.motion_prior, std::pair(2.0, 0.5));
+  settings.localization = true;
+  try {
+    check_run_settings(settings, SettingNames{.keywords = true});
+    FAIL() << "localization without a map was accepted";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "localization: needs load_map (a map to localise in)");
+  }
 }
 
 TEST(RunSettings, LoopClosingAutoNeedsTheVocabularyAndNeverRunsInLocalisation) {

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pspslam/io/sequence_source.h"
 #include "pspslam/system/system.h"
@@ -59,6 +61,9 @@ struct RunOptions {
   std::optional<FrameRange> blackout;
   RunOutputs outputs;
   SystemOptions system;
+  // The run settings the System got (session/run_option_table.h effective_settings): stats.json's
+  // "settings", as Python's System.settings reports them.
+  std::vector<std::pair<std::string, std::string>> settings;
   bool progress = true;  // progress bar on stderr
 };
 

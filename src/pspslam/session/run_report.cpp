@@ -388,6 +388,13 @@ nlohmann::ordered_json run_json(const RunReportInput& input) {
           {"relocalisations", stats.relocalisations()}};
 }
 
+// Every run setting the System got, by its Python keyword (session/run_option_table.h).
+nlohmann::ordered_json settings_json(const RunReportInput& input) {
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  for (const auto& [keyword, value] : input.options.settings) json[keyword] = value;
+  return json;
+}
+
 nlohmann::ordered_json monocular_json(const RunStatistics& stats, bool map_loaded) {
   return {{"initialised_at_frame", stats.initialised_at()
                                        ? nlohmann::ordered_json(*stats.initialised_at())
@@ -496,6 +503,7 @@ nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSec
   if (!reported.blackout.is_null()) json["blackout"] = reported.blackout;
   if (input.requested_mode != system.dynamic.mode)
     json["mode_requested"] = to_string(input.requested_mode);
+  json["settings"] = settings_json(input);
   if (monocular) json["monocular"] = monocular_json(stats, !system.map_file.empty());
   json["lost_stretches"] = lost_stretches_json(stats);
   json["realtime_dropped_frames"] = stats.realtime_dropped();

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdint>
 #include <numbers>
 #include <string>
 
@@ -9,6 +10,7 @@
 #include "pspslam/core/shared_paths.h"
 #include "pspslam/place/place_recognition.h"
 #include "pspslam/semantic/segmenter_metadata.h"
+#include "pspslam/semantic/semantic_delay.h"
 
 namespace pspslam {
 namespace {
@@ -47,6 +49,29 @@ void set_dynamic(const RunSettings& settings, const SettingNames& names, Dynamic
   dynamic.semantic.mask_dilation_px = settings.mask_margin;
   dynamic.segment_every = settings.segment_every;
   dynamic.culling.min_dynamic_hits = settings.cull_hits;
+}
+
+// A live run's answers to a network that falls behind the camera.
+void set_stale_masks(const RunSettings& settings, SystemOptions& system) {
+  DynamicOptions& dynamic = system.dynamic;
+  dynamic.keep_pace = settings.semantic_pace == "on";
+  const std::filesystem::path shipped_smaller = data_dir() / "models/pspnet/pspnet_288x192.yaml";
+  if (settings.smaller_model)
+    dynamic.smaller_model = *settings.smaller_model;
+  else if (!settings.model && std::filesystem::is_regular_file(shipped_smaller))
+    dynamic.smaller_model = shipped_smaller;
+  system.tracker.mover_guard.enabled = settings.mover_guard == "on";
+  dynamic.tighten_geometry = settings.stale_geometry == "on";
+  dynamic.cull_with_late_masks = settings.late_mask_culling == "on";
+  system.tracker.judged_points_first = settings.judged_points_first == "on";
+  dynamic.propagation.max_growth_px = settings.stale_mask_growth;
+  dynamic.stale_masks =
+      settings.stale_masks == "flow" ? StaleMaskPolicy::flow : StaleMaskPolicy::homography;
+  if (!settings.semantic_delay_ms.empty()) {
+    dynamic.semantic.injected_delay =
+        parse_semantic_delay(settings.semantic_delay_ms, "--semantic-delay-ms");
+    dynamic.semantic.injected_delay.seed = static_cast<std::uint32_t>(settings.semantic_delay_seed);
+  }
 }
 
 void set_place(const RunSettings& settings, SystemOptions& system) {
@@ -101,7 +126,12 @@ SystemOptions system_options(const RunSettings& settings, const SettingNames& na
   system.local_ba_fixed_keyframes = settings.local_ba_fixed_keyframes;
   set_tracking(settings, system);
   set_place(settings, system);
-  system.back_end_wait = settings.realtime ? BackEndWait::none : BackEndWait::whole_back_end;
+  set_stale_masks(settings, system);
+  // A live source keeps delivering while the run waits: a loop's global BA (seconds) would drop
+  // a second of frames, so without realtime it waits for local mapping only.
+  system.back_end_wait = settings.realtime      ? BackEndWait::none
+                         : settings.live_camera ? BackEndWait::local_mapping
+                                                : BackEndWait::whole_back_end;
   return system;
 }
 

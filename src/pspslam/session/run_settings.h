@@ -31,7 +31,8 @@ inline constexpr double kNewMapAfterSeconds = 1.0;
 inline constexpr double kLiveNewMapAfterSeconds = 3.0;
 
 // The run settings that shape the System: `pspslam run`'s flags and the Python module's keywords
-// of the same names, with their defaults. Empty optionals take the run's default.
+// of the same names (declared once, session/run_option_table.h), with their defaults. Empty
+// optionals take the run's default.
 struct RunSettings {
   std::string mode = "auto";  // off | semantic | geometry | full | exhaustive | auto
   std::optional<std::filesystem::path> model;           // none: the shipped model
@@ -40,7 +41,9 @@ struct RunSettings {
   std::optional<std::filesystem::path> load_map;
   bool localization = false;  // used with load_map only
   bool realtime = false;
-  bool live_camera = false;  // frames from a live camera: live as with realtime
+  // Frames from a live source as they arrive (`run --camera`, Python's live=True): live as with
+  // realtime, and each frame waits for local mapping only.
+  bool live_camera = false;
   bool local_mapping = true;
   bool relocalization = true;
   // 0: never start a new map; none: kLiveNewMapAfterSeconds when live, else kNewMapAfterSeconds.
@@ -56,6 +59,17 @@ struct RunSettings {
   double ba_tracking_factors = 0.0;       // weight of tracking's relative poses in local BA
   std::optional<int> background_nice;     // none: kLiveBackgroundNice when live, else 0
   std::optional<std::pair<double, double>> motion_prior;  // millimetres, degrees
+  // What a live run does when its network falls behind (each acts with realtime only).
+  std::string semantic_pace = "off";                   // on | off
+  std::optional<std::filesystem::path> smaller_model;  // none: the shipped one with its model
+  std::string stale_masks = "homography";              // homography | flow
+  int stale_mask_growth = MaskPropagationParams{}.max_growth_px;
+  std::string stale_geometry = "on";       // on | off
+  std::string late_mask_culling = "on";    // on | off
+  std::string judged_points_first = "on";  // on | off
+  std::string mover_guard = "off";         // on | off
+  std::string semantic_delay_ms;           // fault injection: MS | random:MIN:MAX; empty: none
+  long long semantic_delay_seed = 1;
 
   // A live run must keep up with its frames, so its background work yields and its BA is capped.
   bool live() const { return realtime || live_camera; }
@@ -67,6 +81,7 @@ struct SettingNames {
   const char* mode = "--dynamic";
   const char* semantic_masks = "--semantic-masks";
   bool explain_model = true;  // say how to get a missing model; warn when auto falls back
+  bool keywords = false;      // name every option by its Python keyword instead of its flag
 };
 
 // The dynamic mode the settings ask for: auto = full when the segmentation model loads, else
@@ -75,8 +90,8 @@ struct SettingNames {
 DynamicMode choose_mode(const RunSettings& settings, const std::filesystem::path& model,
                         const SettingNames& names = {});
 
-// The SystemOptions of a run with these settings. Deterministic unless `realtime`: each frame
-// waits for its mask and the whole back end (a caller with a live camera may wait for less).
+// The SystemOptions of a run with these settings. Deterministic unless `realtime` or
+// `live_camera`: each frame waits for its mask and the whole back end.
 SystemOptions system_options(const RunSettings& settings, const SettingNames& names = {});
 
 }  // namespace pspslam

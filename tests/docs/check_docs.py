@@ -25,10 +25,15 @@ from pathlib import Path
 
 TOP_FOLDERS = ("src", "apps", "tests", "bench", "docs", "python", "examples", "tools", "config",
                "models", "scripts", "cmake", "web", "fuzz", ".ci")
-PATH_RE = re.compile(r"(?<![\w./-])((?:%s)/[\w./*{},+-]*)" %
+PATH_RE = re.compile(r"(?<![\w./-])((?:%s)/[\w./*{},+<>-]*)" %
                      "|".join(re.escape(f) for f in TOP_FOLDERS))
-FILE_NAME_RE = re.compile(r"^[\w-]+\.(?:h|cpp|py|toml|md|yaml|sh|js|html)$")
-FLAG_RE = re.compile(r"(?<![\w-])(--[a-z][a-z0-9-]*)")
+# Names of the repository's own code (a YAML or image name is usually the reader's file).
+FILE_NAME_RE = re.compile(r"^[\w-]+\.(?:h|cpp|py|toml|sh|js|html)$")
+FLAG_RE = re.compile(r"(?<![\w-])(--[a-z][a-z0-9_-]*[a-z0-9])(?![\w*-])")
+# A commit a paragraph names: what it cites may be code of that commit, removed since.
+COMMIT_RE = re.compile(r"\b[0-9a-f]{7,12}\b")
+# Files that are not in the repository: TUM's tools, what scripts/install-deps installs.
+EXTERNAL = ("associate.py", "web/node_modules")
 LINK_RE = re.compile(r"\]\(([^)\s]+)\)")
 SPAN_RE = re.compile(r"`([^`]+)`")
 # Placeholders that stand for a name the reader chooses.
@@ -37,6 +42,9 @@ PLACEHOLDER_RE = re.compile(r"<[^>]*>|\b[A-Z][A-Z_]{2,}\b|\.\.\.|\bNAME\b")
 OTHER_PROGRAMS_FLAGS = {"--install", "--prefix", "--build", "--target", "--output-on-failure",
                         "--gtest_filter", "--help", "--version", "--no-install-recommends",
                         "--preset", "--config", "--parallel", "--test-dir", "--rerun-failed"}
+# Pages or lines that show wrong input on purpose: docs/reliability.md's table (the output of
+# tests/cli/bad_inputs.sh) and "did you mean" examples.
+DELIBERATELY_WRONG = re.compile(r"did you mean")
 
 
 def pages(source):
@@ -157,11 +165,90 @@ def check_command(code, program, makefile_targets):
     return problems
 
 
+def paragraph_commits(text, source):
+    """For each line number, the commits its paragraph names (that exist in the repository)."""
+    commits, paragraph, start = {}, [], 1
+    lines = text.splitlines() + [""]
+    for number, line in enumerate(lines, 1):
+        if line.strip():
+            paragraph.append(line)
+            continue
+        named = {c for c in COMMIT_RE.findall(" ".join(paragraph)) if subprocess.run(
+            ["git", "cat-file", "-e", c + "^{commit}"], cwd=source,
+            capture_output=True).returncode == 0}
+        for n in range(start, number):
+            commits[n] = named
+        paragraph, start = [], number + 1
+    return commits
+
+
+def at_commit(token, commits, source, path):
+    """Whether `token` (a path when `path`, else a name or flag) is in the tree of one of the
+    commits."""
+    for commit in commits:
+        if path:
+            if subprocess.run(["git", "cat-file", "-e", f"{commit}:{token}"], cwd=source,
+                              capture_output=True).returncode == 0:
+                return True
+        elif subprocess.run(["git", "grep", "-q", "-F", "-e", token, commit], cwd=source,
+                            capture_output=True).returncode == 0:
+            return True
+    return False
+
+
+def script_flags_problems(code, source):
+    """A repository script's flags on the line must appear in the script."""
+    problems = []
+    for script in re.findall(r"(?<![\w/])((?:scripts|tools|bench)/[\w./-]+)", code):
+        file = source / script
+        if not file.is_file() or script.endswith("runner.py"):
+            continue
+        text = file.read_text(errors="replace")
+        for flag in FLAG_RE.findall(code.split(script, 1)[1]):
+            if flag not in text:
+                problems.append(f"{flag}: not a flag of {script}")
+    return problems
+
+
+def code_problems(code, source, files, folders, program, makefile_targets, tests):
+    problems = []
+    for token in PATH_RE.findall(code):
+        token = token.rstrip(".,;:")
+        if token.startswith(EXTERNAL) or check_path(token, source, files, folders):
+            continue
+        in_history = "git log" in code and subprocess.run(
+            ["git", "log", "-1", "--format=%h", "--", token], cwd=source, capture_output=True,
+            text=True).stdout.strip()
+        if not in_history:
+            problems.append((token, True, f"{token}: no such path"))
+    for token in code.split():
+        token = token.strip("(),;:'\"")
+        if (FILE_NAME_RE.match(token) and "/" not in token and token not in EXTERNAL and
+                not PLACEHOLDER_RE.search(token) and not any(Path(f).name == token
+                                                              for f in files)):
+            problems.append((token, False, f"{token}: no such file in the repository"))
+    for problem in check_command(code, program, makefile_targets):
+        problems.append((problem.split(":")[0].split()[-1], False, problem))
+    for problem in script_flags_problems(code, source):
+        problems.append((problem.split(":")[0], False, problem))
+    if code.lstrip().startswith("--"):  # a flag alone: of pspslam or the runner
+        for flag in FLAG_RE.findall(code):
+            if flag not in program.all_flags and flag not in OTHER_PROGRAMS_FLAGS:
+                problems.append((flag, False, f"{flag}: not a flag of pspslam or "
+                                              "bench/runner.py"))
+    for pattern in re.findall(r"ctest\s+(?:[\w-]+\s+)*-R\s+'?([\w.*|\\-]+)", code):
+        if not any(re.search(pattern, test) for test in tests):
+            problems.append((pattern, False, f"ctest -R {pattern}: matches no test"))
+    return problems
+
+
 def check_page(page, source, files, folders, program, makefile_targets, tests):
     text = page.read_text()
     relative = page.relative_to(source)
+    commits = paragraph_commits(text, source)
+    lines = text.splitlines()
     problems = []
-    for number, line in enumerate(text.splitlines(), 1):
+    for number, line in enumerate(lines, 1):
         for link in LINK_RE.findall(line):
             if re.match(r"^[a-z]+:", link) or link.startswith("#"):
                 continue
@@ -169,24 +256,14 @@ def check_page(page, source, files, folders, program, makefile_targets, tests):
             if not target.exists():
                 problems.append(f"{relative}:{number}: link {link}: no such file")
     for number, code in code_lines(text):
-        for token in PATH_RE.findall(code):
-            if not check_path(token, source, files, folders):
-                problems.append(f"{relative}:{number}: {token}: no such path")
-        for token in code.split():
-            token = token.strip("(),;:'\"")
-            if FILE_NAME_RE.match(token) and "/" not in token and not PLACEHOLDER_RE.search(
-                    token) and not any(Path(f).name == token for f in files):
-                problems.append(f"{relative}:{number}: {token}: no such file in the repository")
-        problems += [f"{relative}:{number}: {p}"
-                     for p in check_command(code, program, makefile_targets)]
-        if not re.search(r"pspslam\s|runner\.py|make\s", code):
-            for flag in FLAG_RE.findall(code):
-                if flag not in program.all_flags and flag not in OTHER_PROGRAMS_FLAGS:
-                    problems.append(f"{relative}:{number}: {flag}: not a flag of pspslam or "
-                                    "bench/runner.py")
-        for pattern in re.findall(r"ctest\s+(?:[\w-]+\s+)*-R\s+'?([\w.*|\\-]+)", code):
-            if not any(re.search(pattern, test) for test in tests):
-                problems.append(f"{relative}:{number}: ctest -R {pattern}: matches no test")
+        line = lines[number - 1]
+        if DELIBERATELY_WRONG.search(line) or (
+                str(relative) == "docs/reliability.md" and line.startswith("|")):
+            continue
+        for token, is_path, problem in code_problems(code, source, files, folders, program,
+                                                     makefile_targets, tests):
+            if not at_commit(token, commits.get(number, ()), source, is_path):
+                problems.append(f"{relative}:{number}: {problem}")
     return problems
 
 

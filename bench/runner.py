@@ -315,7 +315,9 @@ def regenerate_command(args, experiment):
     """The command that regenerates a section, as run from the repository's root: the runner
     and the experiment by their repository paths, and only what changes the figures (where the
     build, the shared folder and the work folder lie is the reader's own)."""
-    words = ["bench/runner.py", "run", experiment.path.resolve().relative_to(REPO).as_posix()]
+    path = experiment.path.resolve()
+    shown = path.relative_to(REPO).as_posix() if path.is_relative_to(REPO) else str(experiment.path)
+    words = ["bench/runner.py", "run", shown]
     if experiment.needs_download():
         words += ["--data", "DIR"]
     if getattr(args, "variants", None):

@@ -9,6 +9,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/core/output_paths.h"
 #include "pspslam/core/progress.h"
+#include "pspslam/synth/occupancy_truth.h"
 #include "pspslam/synth/scene.h"
 #include "pspslam/synth/sequence_writer.h"
 
@@ -24,6 +25,7 @@ struct SynthFlags {
   std::vector<std::string> no_faults;
   std::string out;
   std::string layout = "tum";
+  double occupancy_truth = 0.0;  // cell size of the occupancy truth; 0 = none
 };
 
 // Where the sequence goes, how long it is and what moves in it.
@@ -91,6 +93,11 @@ void add_extra_options(CLI::App* app, SynthFlags& flags) {
                   "state_groundtruth_estimate0)")
       ->check(CLI::IsMember({"tum", "kitti", "euroc"}))
       ->capture_default_str();
+  app->add_option("--occupancy-truth", flags.occupancy_truth,
+                  "also write the room's true occupancy at this cell size in metres "
+                  "(occupancy_truth/: static, seen and swept cells, exact camera poses), for "
+                  "scoring 'pspslam run --occupancy-truth'")
+      ->check(in_range(0.005, 1.0));
   app->add_option("--threads", options.threads, "worker threads (0 = all cores)")
       ->check(in_range(0, 256))
       ->capture_default_str();
@@ -121,6 +128,13 @@ int synthesize(const SynthFlags& flags, const GlobalOptions& global) {
   ProgressBar progress("synth", options.frames, std::cerr, !global.quiet);
   write_sequence(scene, flags.out, [&](size_t done) { progress.update(done); });
   progress.finish();
+  if (flags.occupancy_truth > 0.0) {
+    const OccupancyTruth truth =
+        compute_occupancy_truth(scene, {.resolution = flags.occupancy_truth,
+                                        .max_range_m = scene.system_config().camera.depth_threshold,
+                                        .threads = options.threads});
+    write_occupancy_truth(truth, std::filesystem::path(flags.out) / "occupancy_truth");
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "wrote " << options.frames << " frames (" << options.bodies << " bodies, "

@@ -799,6 +799,24 @@ SystemConfig SyntheticScene::system_config() const {
   return config;
 }
 
+std::vector<SynthBox> SyntheticScene::static_boxes() const {
+  std::vector<SynthBox> boxes;
+  for (size_t i = 0; i < impl_->static_boxes.size(); ++i)
+    boxes.push_back({impl_->static_poses[i], impl_->static_boxes[i].half_extents});
+  return boxes;
+}
+
+std::vector<SynthBox> SyntheticScene::body_boxes_at(double seconds) const {
+  std::vector<SynthBox> boxes;
+  std::vector<synth::BodyPartPose> parts;
+  for (const synth::WalkingBody& body : impl_->bodies) {
+    body.pose_parts(seconds, parts);
+    for (const synth::BodyPartPose& part : parts)
+      boxes.push_back({part.T_world_part, part.half_extents});
+  }
+  return boxes;
+}
+
 Trajectory SyntheticScene::ground_truth() const {
   Trajectory trajectory;
   for (size_t i = 0; i < frame_count(); ++i) trajectory.push_back({timestamp(i), camera_pose(i)});

@@ -5,6 +5,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/config/config.h"
@@ -23,6 +24,12 @@ inline constexpr uint8_t kSynthLabelCarried = 100;  // a box (static class) carr
 inline constexpr int kMaxBodies = 200;
 
 enum class SynthTrajectory { kHandheld, kLoop };
+
+// A box of the scene at some instant: the world pose of its centre and its half extents.
+struct SynthBox {
+  Pose T_world_box = Pose::Identity();
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();
+};
 
 // ideal: a perfect RGB-D camera (registered, synchronised, global shutter, no distortion; depth
 // noise per --depth-noise). kinect: a hand-held structured-light camera with the faults of
@@ -110,6 +117,11 @@ class SyntheticScene {
   SystemConfig system_config() const;
   // The RGB-D config of the same sequence (config_rgbd.yaml beside a stereo config.yaml).
   SystemConfig rgbd_system_config() const;
+  // The static geometry: the room first (a box seen from inside: its faces are the walls, the
+  // floor and the ceiling), then the furniture (solid boxes).
+  std::vector<SynthBox> static_boxes() const;
+  // Every body part (and carried box) of every walking person at `seconds` after the first frame.
+  std::vector<SynthBox> body_boxes_at(double seconds) const;
 
  private:
   struct Impl;

@@ -32,6 +32,7 @@
 
 #include "commands.h"
 #include "flag_checks.h"
+#include "occupancy_flags.h"
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/core/shared_paths.h"
@@ -119,6 +120,7 @@ struct RunFlags {
       std::vector<std::vector<std::string>>(run_option_table().size());
   std::vector<CLI::Option*> option_given = std::vector<CLI::Option*>(run_option_table().size());
   RunSettings settings;  // gathered while parsing
+  OccupancyFlags occupancy;
 };
 
 // The flags that shape the System, as the library's RunSettings: the table's defaults, each
@@ -159,8 +161,10 @@ RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   options.outputs.export_dense = flags.export_dense;
   options.outputs.masks = flags.save_masks;
   options.outputs.overlays = flags.save_overlays;
+  options.occupancy = occupancy_options(flags.occupancy);
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
+  prepare_occupancy_outputs(options.occupancy);
   return options;
 }
 
@@ -431,6 +435,7 @@ Command add_run_command(CLI::App& root) {
   add_live_options(app, *flags);
   add_map_options(app, *flags);
   add_output_options(app, *flags);
+  add_occupancy_options(app, flags->occupancy);
   add_viewer_options(app, *flags);
   return {app, [flags](const GlobalOptions& global) { return run_slam(*flags, global); }};
 }

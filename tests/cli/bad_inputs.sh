@@ -109,6 +109,13 @@ row "--out is a regular file" 2 -- "$cli" run --sequence seq --out a_file
 row "--save-map names a folder" 2 -- $R --sequence seq --save-map seq
 row "--export-map below a regular file" 2 -- $R --sequence seq --export-map a_file/map.ply
 row "--export-dense below a regular file" 2 -- $R --sequence seq --export-dense a_file/dense.ply
+row "--export-octomap below a regular file" 2 -- $R --sequence seq --export-octomap a_file/map.bt
+row "--export-grid below a regular file" 2 -- $R --sequence seq --export-grid a_file/grid.yaml
+row "--occupancy-resolution 0" 2 -- $R --sequence seq --occupancy --occupancy-resolution 0
+row "--occupancy-resolution -0.05" 2 -- $R --sequence seq --export-grid g.yaml --occupancy-resolution -0.05
+row "height band upside down" 2 -- $R --sequence seq --export-grid g.yaml --grid-min-height 1.2 --grid-max-height 0.3
+row "--grid-floor low" 2 -- $R --sequence seq --export-grid g.yaml --grid-floor low
+row "--occupancy-truth without static.txt" 2 -- $R --sequence seq --occupancy-truth seq
 row "--save-masks below a regular file" 2 -- $R --sequence seq --save-masks a_file/masks
 row "--save-overlays is a regular file" 2 -- $R --sequence seq --save-overlays a_file
 row "eval --title without its value" 2 -- "$cli" eval --gt seq/groundtruth.txt --est good/trajectory.txt --title

@@ -18,6 +18,8 @@ octomap::point3d to_octomap(const Eigen::Vector3d& p) {
 
 Eigen::Vector3d to_eigen(const octomap::point3d& p) { return {p.x(), p.y(), p.z()}; }
 
+constexpr double kSeenThroughMarginVoxels = 3.0;
+
 }  // namespace
 
 KeyframeScan make_keyframe_scan(std::uint64_t keyframe_id, const PinholeCamera& camera,
@@ -141,10 +143,18 @@ bool OccupancyMap::occupied_near(const Eigen::Vector3d& point) const {
 std::vector<Eigen::Vector3d> OccupancyMap::seen_through(
     const std::vector<std::pair<const KeyframeScan*, Pose>>& scans) const {
   const octomap::OcTree& tree = impl_->tree;
+  // A ray sees through a voxel when it ends well behind it: rays are cut this far before their
+  // reading, so that depth noise at a surface is not taken for a view through it.
+  const float margin = static_cast<float>(kSeenThroughMarginVoxels * tree.getResolution());
   std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> found;
   for (size_t k = 0; k < scans.size(); ++k) {
+    KeyframeScan cut;
+    for (const Eigen::Vector3f& point : scans[k].first->points) {
+      const float range = point.norm();
+      if (range > margin) cut.points.push_back(point * ((range - margin) / range));
+    }
     octomap::KeySet free_cells, occupied_cells;
-    impl_->compute_update(*scans[k].first, scans[k].second, free_cells, occupied_cells);
+    impl_->compute_update(cut, scans[k].second, free_cells, occupied_cells);
     for (const octomap::OcTreeKey& key : free_cells) {
       const auto hit = impl_->first_hit.find(key);
       if (hit == impl_->first_hit.end() || hit->second >= k) continue;

@@ -55,7 +55,8 @@ class OccupancyMap {
   bool occupied_near(const Eigen::Vector3d& point) const;
 
   // Occupied voxels (centres) that a ray of a scan inserted after the voxel's first hit passes
-  // through: what later views saw through. `scans` in insertion order, with their poses.
+  // through, ending at least three voxels behind it: what later views saw through. `scans` in
+  // insertion order, with their poses.
   std::vector<Eigen::Vector3d> seen_through(
       const std::vector<std::pair<const KeyframeScan*, Pose>>& scans) const;
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "pspslam/core/thread_cpu_time.h"
 #include "pspslam/core/thread_priority.h"
 #include "pspslam/map/keyframe.h"
 
@@ -75,10 +76,12 @@ void OccupancyMapper::insert_ready(bool all) {
     Entry& entry = entries_[i];
     if (entry.inserted) continue;
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = thread_cpu_ms();
     entry.T_world_camera_inserted = entry.keyframe->T_world_camera();
     map_.insert(entry.scan, entry.T_world_camera_inserted);
     entry.inserted = true;
     stats_.insert_ms_total += elapsed_ms(start);
+    stats_.insert_cpu_ms_total += thread_cpu_ms() - cpu_start;
     ++stats_.inserted;
   }
 }

@@ -18,10 +18,11 @@ namespace pspslam {
 class KeyFrame;
 
 struct OccupancyStats {
-  size_t keyframes = 0;          // scans kept (one per keyframe)
-  size_t inserted = 0;           // scans inserted while the run went
-  size_t live_rebuilds = 0;      // rebuilds because inserted keyframes moved
-  double insert_ms_total = 0.0;  // incremental insertions (own thread)
+  size_t keyframes = 0;              // scans kept (one per keyframe)
+  size_t inserted = 0;               // scans inserted while the run went
+  size_t live_rebuilds = 0;          // rebuilds because inserted keyframes moved
+  double insert_ms_total = 0.0;      // incremental insertions (own thread), wall time
+  double insert_cpu_ms_total = 0.0;  // the same, CPU time of the thread
   double rebuild_ms_total = 0.0;
   double final_rebuild_ms = 0.0;  // finish(): every scan at its keyframe's final pose
   size_t map_bytes = 0;           // the octree
@@ -51,7 +52,7 @@ class OccupancyMapper {
   // (a culled keyframe at its last one). Call once, after the system has shut down.
   void finish();
 
-  // Runs `read` on the map under its lock.
+  // Runs `read` on the map under its lock (`read` must not call back into this object).
   void read(const std::function<void(const OccupancyMap&)>& read) const;
   OccupancyStats stats() const;
   std::vector<Eigen::Vector3d> camera_centres() const;

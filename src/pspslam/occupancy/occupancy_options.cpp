@@ -12,8 +12,8 @@ void OccupancyOptions::validate() const {
     throw Error("flag --occupancy-resolution: must be > 0 metres, got " +
                 std::to_string(resolution_m));
   if (!(max_range_m > resolution_m))
-    throw Error("occupancy: the maximum range (" + std::to_string(max_range_m) +
-                " m) must exceed --occupancy-resolution");
+    throw Error("flag --occupancy-max-range: must exceed --occupancy-resolution, got " +
+                std::to_string(max_range_m) + " m");
   if (pixel_stride < 1) throw Error("occupancy: the pixel stride must be >= 1");
   if (insert_delay_keyframes < 0) throw Error("occupancy: the insertion delay must be >= 0");
 }

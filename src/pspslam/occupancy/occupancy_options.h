@@ -7,7 +7,7 @@ namespace pspslam {
 // How keyframes become the occupancy map of the static scene (`pspslam run --occupancy`).
 struct OccupancyOptions {
   double resolution_m = 0.05;  // --occupancy-resolution: voxel edge
-  double max_range_m = 4.0;    // rays are cut here; farther readings mark free space only
+  double max_range_m = 4.0;    // --occupancy-max-range: farther readings mark free space only
   int pixel_stride = 4;        // every stride-th pixel in x and y of a keyframe's depth
   bool use_masks = true;       // --occupancy-masks: leave the dynamic pixels out
   bool clearing = true;        // --occupancy-clearing: rays free the cells they pass through

@@ -9,7 +9,7 @@ namespace {
 bool truth_column_occupied(const OccupancyTruth& truth, const Eigen::Vector3d& point,
                            const GridOptions& options) {
   for (double z = options.min_height_m; z <= options.max_height_m; z += truth.resolution / 2.0) {
-    if (truth.static_cells.contains(truth.cell_of({point.x(), point.y(), z}))) return true;
+    if (truth.static_near(truth.cell_of({point.x(), point.y(), z}))) return true;
   }
   return false;
 }
@@ -47,7 +47,7 @@ OccupancyScore score_occupancy(const OccupancyMap& map, const OccupancyGrid* gri
     if (!occupied) return;
     ++score.occupied;
     const VoxelIndex cell = truth.cell_of(alignment.apply(centre));
-    const bool is_static = truth.static_cells.contains(cell);
+    const bool is_static = truth.static_near(cell);
     correct += is_static;
     score.ghosts += !is_static && truth.swept_cells.contains(cell);
   });

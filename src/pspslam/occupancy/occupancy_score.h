@@ -13,11 +13,11 @@ namespace pspslam {
 // truth's frame by the SE(3) alignment of the keyframe trajectory onto the exact camera poses.
 struct OccupancyScore {
   size_t occupied = 0;        // occupied voxels of the map
-  double precision = 0;       // occupied voxels within one truth cell of the static geometry
+  double precision = 0;       // occupied voxels within one cell of a static truth cell
   size_t seen = 0;            // static truth cells the camera saw
   double recall = 0;          // seen cells with an occupied voxel within one voxel
   size_t swept = 0;           // cells the people swept through
-  size_t ghosts = 0;          // occupied voxels in swept cells that are not static
+  size_t ghosts = 0;          // occupied voxels in swept cells, not within one cell of a static one
   double ghost_fraction = 0;  // ghosts / swept
   size_t grid_known = 0;      // grid cells free or occupied
   double grid_agreement = 0;  // known grid cells whose state the truth's band agrees with

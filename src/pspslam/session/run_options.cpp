@@ -23,4 +23,15 @@ void prepare_run_outputs(const RunOutputs& outputs) {
   }
 }
 
+void prepare_occupancy_outputs(const OccupancyRunOptions& occupancy) {
+  occupancy.validate();
+  if (!occupancy.export_octomap.empty())
+    prepare_output_file(occupancy.export_octomap, "--export-octomap");
+  if (!occupancy.export_grid.empty()) {
+    prepare_output_file(occupancy.export_grid, "--export-grid");
+    std::filesystem::path image = occupancy.export_grid;
+    prepare_output_file(image.replace_extension(".pgm"), "--export-grid");
+  }
+}
+
 }  // namespace pspslam

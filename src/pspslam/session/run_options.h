@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pspslam/io/sequence_source.h"
+#include "pspslam/session/occupancy_run.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam {
@@ -39,6 +40,9 @@ struct RunOutputs {
 // Checks every output path and creates the folders (core/output_paths.h) before any work, so a
 // run never computes for minutes and then fails to write. Errors name the CLI flag of the path.
 void prepare_run_outputs(const RunOutputs& outputs);
+// The same for the occupancy map's files (--export-octomap, --export-grid), after checking its
+// options.
+void prepare_occupancy_outputs(const OccupancyRunOptions& occupancy);
 
 // One run of the system (`pspslam run`).
 struct RunOptions {
@@ -64,7 +68,8 @@ struct RunOptions {
   // The run settings the System got (session/run_option_table.h effective_settings): stats.json's
   // "settings", as Python's System.settings reports them.
   std::vector<std::pair<std::string, std::string>> settings;
-  bool progress = true;  // progress bar on stderr
+  OccupancyRunOptions occupancy;  // the occupancy map and its exports
+  bool progress = true;           // progress bar on stderr
 };
 
 // How a run ended (the CLI maps it to an exit status).

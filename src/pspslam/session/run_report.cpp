@@ -531,6 +531,7 @@ nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSec
   add_map_json(input, json);
   json["atlas"] = atlas_json(input.atlas);
   add_ate_json(reported.ate, monocular, json);
+  json["occupancy"] = input.occupancy != nullptr ? *input.occupancy : nlohmann::ordered_json();
   return json;
 }
 

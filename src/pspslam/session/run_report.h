@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <ostream>
 
@@ -34,6 +35,7 @@ struct RunReportInput {
   // for, and the note of the summary.
   DynamicMode requested_mode = DynamicMode::off;
   std::string dynamic_note;
+  const nlohmann::ordered_json* occupancy = nullptr;  // stats.json "occupancy"; null: none
 };
 
 // The run's summary: printed to `out` (frames, speed, map, loops, ATE against the sequence's

@@ -108,6 +108,8 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
   system_ = std::make_unique<System>(input_.config, options_.system);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(input_.config.camera.pinhole);
+  if (options_.occupancy.enabled)
+    occupancy_ = std::make_unique<OccupancyRun>(input_.config.camera.pinhole, options_.occupancy);
 }
 
 SequenceRunner::~SequenceRunner() = default;
@@ -212,6 +214,9 @@ MappingStats SequenceRunner::record_frame(const InputFrame& frame, const FrameRe
   if (exporter_ && result.keyframe_inserted)
     exporter_->remember_keyframe(system_->map().max_keyframe_id(), frame.bgr, frame.depth,
                                  system_->last_dynamic_mask());
+  if (occupancy_ && result.keyframe_inserted)
+    occupancy_->add_keyframe(system_->map().keyframe(system_->map().max_keyframe_id()), frame.depth,
+                             system_->last_dynamic_mask());
   if (start_watch.update(result)) spdlog::warn("{}", start_watch.reason());
   // The frame that started a monocular map also placed frames before it (oldest first).
   estimate_.insert(estimate_.end(), result.earlier_frames.begin(), result.earlier_frames.end());
@@ -291,6 +296,7 @@ void SequenceRunner::finish(double seconds) {
   }
   const MappingStats mapping = system_->mapping_stats();
   if (exporter_) write_map_exports(options_.outputs, *exporter_, system_->map(), out_);
+  if (occupancy_) occupancy_->finish(system_->keyframe_trajectory(final_maps.front().map_id), out_);
   const AtlasSummary atlas{.new_map_after_seconds = options_.system.tracker.new_map_after_seconds,
                            .maps = statistics_.frames_per_map(),
                            .merges = mapping.map_merges,
@@ -310,7 +316,8 @@ void SequenceRunner::finish(double seconds) {
                     .sensor = input_.config.camera.type,
                     .config_file = input_.config_file,
                     .requested_mode = limits_.requested_mode,
-                    .dynamic_note = limits_.dynamic_note},
+                    .dynamic_note = limits_.dynamic_note,
+                    .occupancy = occupancy_ ? &occupancy_->json() : nullptr},
                    out_);
 }
 

@@ -75,7 +75,8 @@ class SequenceRunner {
   FrameLog log_;
   FrameImageWriter images_;  // --save-masks / --save-overlays
   std::unique_ptr<System> system_;
-  std::optional<MapExporter> exporter_;  // with --export-map / --export-dense
+  std::optional<MapExporter> exporter_;      // with --export-map / --export-dense
+  std::unique_ptr<OccupancyRun> occupancy_;  // with --occupancy
   RunStatistics statistics_;
   Trajectory estimate_;
   RunObserver* observer_ = nullptr;

@@ -49,7 +49,8 @@ void for_cells_near(const OccupancyTruth& truth, const SynthBox& box, double mar
 
 void add_static_cells(const SyntheticScene& scene, OccupancyTruth& truth) {
   const std::vector<SynthBox> boxes = scene.static_boxes();
-  const double r = truth.resolution;
+  // A cell the geometry passes through has its centre within half its diagonal of it.
+  const double r = truth.resolution * std::sqrt(3.0) / 2.0;
   for_cells_near(truth, boxes.front(), 2.0 * r, [&](const VoxelIndex& cell) {
     if (distance_to_faces(boxes.front(), truth.centre_of(cell)) <= r)
       truth.static_cells.insert(cell);
@@ -149,6 +150,14 @@ VoxelIndex OccupancyTruth::cell_of(const Eigen::Vector3d& point) const {
           static_cast<int>(std::floor(point.z() / resolution))};
 }
 
+bool OccupancyTruth::static_near(const VoxelIndex& cell) const {
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (static_cells.contains({cell.x + x, cell.y + y, cell.z + z})) return true;
+  return false;
+}
+
 Eigen::Vector3d OccupancyTruth::centre_of(const VoxelIndex& cell) const {
   return (Eigen::Vector3d(cell.x, cell.y, cell.z) + Eigen::Vector3d::Constant(0.5)) * resolution;
 }
@@ -172,7 +181,8 @@ void write_occupancy_truth(const OccupancyTruth& truth, const fs::path& dir) {
   fs::create_directories(dir, error);
   if (error) throw Error("synth: cannot create " + dir.string() + ": " + error.message());
   write_cells(truth.static_cells, truth.resolution,
-              "static cells: centre within one cell of the walls, floor, ceiling or furniture",
+              "static cells: centre within half a cell diagonal of the walls, floor, ceiling or "
+              "furniture",
               dir / "static.txt");
   std::ostringstream seen;
   seen << "seen cells: static cells holding exact depth of a static pixel within "

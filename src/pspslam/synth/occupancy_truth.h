@@ -27,9 +27,9 @@ using VoxelSet = std::unordered_set<VoxelIndex, VoxelIndexHash>;
 
 // The true occupancy of a synthetic sequence (`pspslam synth --occupancy-truth RES`), what an
 // occupancy map of it is scored against:
-//   static_cells: cells whose centre lies within one cell of the static geometry (the room's
-//     walls, floor and ceiling, and the furniture, solid): the room's true occupancy with a
-//     tolerance of one cell;
+//   static_cells: cells the static geometry passes through (centre within half a cell diagonal
+//     of the room's walls, floor and ceiling, or of the furniture, solid): the room's true
+//     occupancy;
 //   seen_cells: the static cells that some frame's camera saw within `max_range_m` (cells holding
 //     a point of the exact depth on a static pixel, every `frame_step`-th frame): what a map of
 //     the sequence can recall;
@@ -43,6 +43,8 @@ struct OccupancyTruth {
   Trajectory camera_poses;  // T_world_camera per frame
 
   VoxelIndex cell_of(const Eigen::Vector3d& point) const;
+  // Whether the cell or one of its 26 neighbours is static (a tolerance of one cell).
+  bool static_near(const VoxelIndex& cell) const;
   Eigen::Vector3d centre_of(const VoxelIndex& cell) const;
 };
 

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <ostream>
+
+#include "pspslam/camera/pinhole_camera.h"
+#include "pspslam/core/types.h"
+#include "pspslam/occupancy/occupancy_mapper.h"
+#include "pspslam/occupancy/occupancy_options.h"
+
+namespace pspslam {
+
+class KeyFrame;
+
+// `pspslam run --occupancy` and its outputs.
+struct OccupancyRunOptions {
+  bool enabled = false;  // --occupancy, or implied by --export-octomap / --export-grid
+  OccupancyOptions map;
+  GridOptions grid;
+  std::filesystem::path export_octomap;  // OctoMap binary (.bt)
+  std::filesystem::path export_grid;     // map_server YAML, PGM beside it
+  // A synthetic sequence's occupancy_truth/ (pspslam synth --occupancy-truth): the map is scored
+  // against it in stats.json.
+  std::filesystem::path truth;
+
+  // Throws pspslam::Error naming the flag of a bad value; checks the truth folder exists.
+  void validate() const;
+};
+
+// The occupancy map of one run: built while it goes (OccupancyMapper), then rebuilt at the final
+// poses, exported, counted (occupied grid cells later keyframes saw through) and scored.
+class OccupancyRun {
+ public:
+  OccupancyRun(const PinholeCamera& camera, OccupancyRunOptions options);
+
+  // A new keyframe with the frame's depth and final dynamic mask (shared, not copied).
+  void add_keyframe(std::shared_ptr<const KeyFrame> keyframe, const cv::Mat& depth,
+                    const cv::Mat& dynamic_mask);
+  // After the system has shut down: the final map, the exports and the scores (keyframes: the
+  // final keyframe trajectory, for the alignment to the truth). Prints a line per output.
+  void finish(const Trajectory& keyframes, std::ostream& out);
+  // stats.json's "occupancy" member (after finish()).
+  const nlohmann::ordered_json& json() const { return json_; }
+  const OccupancyMapper& mapper() const { return mapper_; }
+
+ private:
+  OccupancyRunOptions options_;
+  OccupancyMapper mapper_;
+  nlohmann::ordered_json json_;
+};
+
+}  // namespace pspslam

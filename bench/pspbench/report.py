@@ -245,8 +245,15 @@ def column_table(experiment, table):
             values = [stats.median_or_none([stats_value(r, experiment.columns[label])
                                             for r in runs.results]) for label in labels]
             lines.append(f"| {cell.name} | {variant.name} | "
-                         + " | ".join("—" if v is None else f"{v:.1f}" for v in values) + " |")
+                         + " | ".join(_column_value(v) for v in values) + " |")
     return lines
+
+
+def _column_value(value):
+    """A column's value: one decimal, or three significant digits for fractions."""
+    if value is None:
+        return "—"
+    return f"{value:.3g}" if abs(value) < 1 else f"{value:.1f}"
 
 
 def finished_runs(experiment, table, lines):

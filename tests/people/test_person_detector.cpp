@@ -21,13 +21,13 @@ struct Scene {
   }
 };
 
-// Where the detector should put a rectangle's person: its centre pixel's ray, 0.1 m behind.
+// Where the detector should put a rectangle's person: its centre pixel's ray, 0.15 m behind.
 Eigen::Vector3d expected_centre(const cv::Rect& box, double z) {
   const PinholeCamera cam = camera();
   const Eigen::Vector3d ray =
       cam.unproject(Eigen::Vector2d(box.x + box.width / 2.0, box.y + box.height / 2.0), 1.0)
           .normalized();
-  return ray * (z / ray.z() + 0.10);
+  return ray * (z / ray.z() + 0.15);
 }
 
 TEST(PersonDetector, TwoPeopleAtDifferentDepthsAreTwoInstancesEvenWhereTheyOverlap) {
@@ -67,6 +67,17 @@ TEST(PersonDetector, OtherClassesNoDepthAndSmallFragmentsAreNotPeople) {
   PersonDetector detector;
   EXPECT_TRUE(
       detector.detect(scene.labels, kPerson, scene.depth, camera(), Pose::Identity()).empty());
+}
+
+TEST(PersonDetector, APersonPaintedOnTheWallIsNotAPerson) {
+  Scene scene;
+  scene.labels(cv::Rect(100, 100, 120, 240)).setTo(kPerson);  // at the wall's depth
+  scene.person(cv::Rect(400, 100, 80, 240), 2.0f);            // in front of it
+  PersonDetector detector;
+  const std::vector<PersonObservation> people =
+      detector.detect(scene.labels, kPerson, scene.depth, camera(), Pose::Identity());
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_GT(people[0].position_camera.x(), 0.0);
 }
 
 TEST(PersonDetector, CentresAreMovedIntoTheWorldByTheCameraPose) {

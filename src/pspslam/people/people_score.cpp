@@ -16,7 +16,7 @@ namespace {
 
 long long frame_key(Timestamp t) { return std::llround(t * 1e6); }
 
-double quantile(std::vector<double> values, double q) {
+double quantile_of(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
   const auto at = values.begin() + static_cast<std::ptrdiff_t>(q * (values.size() - 1) + 0.5);
   std::nth_element(values.begin(), at, values.end());
@@ -123,10 +123,10 @@ PeopleScore score_people(const std::vector<PersonTruth>& truth,
     }
   }
   score.person_minutes = score.person_frames * period / 60.0;
-  score.median_position_error_m = quantile(errors, 0.5);
-  score.p90_position_error_m = quantile(errors, 0.9);
-  score.median_horizontal_error_m = quantile(horizontal, 0.5);
-  score.median_velocity_error_mps = quantile(velocity_errors, 0.5);
+  score.median_position_error_m = quantile_of(errors, 0.5);
+  score.p90_position_error_m = quantile_of(errors, 0.9);
+  score.median_horizontal_error_m = quantile_of(horizontal, 0.5);
+  score.median_velocity_error_mps = quantile_of(velocity_errors, 0.5);
   score.distinct_ids = static_cast<int>(ids.size());
   return score;
 }

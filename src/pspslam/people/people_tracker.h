@@ -12,7 +12,7 @@ namespace pspslam {
 struct PeopleTrackerParams {
   // How fast a person changes velocity (white-noise acceleration of the constant-velocity
   // filter), m/s^2, and how far an observed centre lies from the true one, m.
-  double acceleration_sigma = 2.0;
+  double acceleration_sigma = 1.0;
   double observation_sigma_m = 0.08;
   // An observation joins a track when it lies within gate_m plus twice the predicted position's
   // standard deviation of the prediction, at most max_gate_m (a person after an occlusion).

@@ -21,6 +21,7 @@ void PersonDetector::sample(const cv::Mat& labels, int person_label, const cv::M
   grid_w_ = depth.cols / step;
   grid_h_ = depth.rows / step;
   grid_depth_.assign(static_cast<size_t>(grid_w_) * static_cast<size_t>(grid_h_), 0.0f);
+  all_depth_.assign(grid_depth_.size(), 0.0f);
   const double label_x = static_cast<double>(labels.cols) / depth.cols;
   const double label_y = static_cast<double>(labels.rows) / depth.rows;
   for (int gy = 0; gy < grid_h_; ++gy) {
@@ -32,8 +33,9 @@ void PersonDetector::sample(const cv::Mat& labels, int person_label, const cv::M
       const int label = label_row[static_cast<int>(x * label_x)];
       const bool person = person_label < 0 ? label != 0 : label == person_label;
       const float z = depth_row[x];
-      if (person && z > 0.0f && z < params_.max_depth_m)
-        grid_depth_[static_cast<size_t>(gy * grid_w_ + gx)] = z;
+      if (!(z > 0.0f && z < params_.max_depth_m)) continue;
+      all_depth_[static_cast<size_t>(gy * grid_w_ + gx)] = z;
+      if (person) grid_depth_[static_cast<size_t>(gy * grid_w_ + gx)] = z;
     }
   }
 }
@@ -87,6 +89,27 @@ void PersonDetector::label_components() {
   instances_.resize(count);
 }
 
+double PersonDetector::standout(const Instance& instance, std::int32_t id) const {
+  const int step = std::max(1, params_.grid_step);
+  const int x0 = instance.min_x / step, x1 = instance.max_x / step;
+  const int y0 = instance.min_y / step, y1 = instance.max_y / step;
+  const int grow_x = static_cast<int>((x1 - x0 + 1) * params_.standout_window) + 1;
+  const int grow_y = static_cast<int>((y1 - y0 + 1) * params_.standout_window) + 1;
+  std::vector<float> depths = instance.depth;
+  const float z = quantile(depths, 0.5);
+  const float behind_from = z + params_.depth_jump_abs_m + params_.depth_jump_rel * z;
+  int around = 0, behind = 0;
+  for (int gy = std::max(0, y0 - grow_y); gy < std::min(grid_h_, y1 + grow_y + 1); ++gy) {
+    for (int gx = std::max(0, x0 - grow_x); gx < std::min(grid_w_, x1 + grow_x + 1); ++gx) {
+      const size_t at = static_cast<size_t>(gy * grid_w_ + gx);
+      if (grid_id_[at] == id || all_depth_[at] <= 0.0f) continue;
+      ++around;
+      behind += all_depth_[at] > behind_from;
+    }
+  }
+  return around > 0 ? static_cast<double>(behind) / around : 1.0;
+}
+
 PersonObservation PersonDetector::observe(Instance& instance, const PinholeCamera& camera) const {
   const int step = std::max(1, params_.grid_step);
   PersonObservation person;
@@ -119,8 +142,11 @@ std::vector<PersonObservation> PersonDetector::detect(const cv::Mat& labels, int
   label_components();
   const int step = std::max(1, params_.grid_step);
   const size_t min_samples = static_cast<size_t>(std::max(1, params_.min_pixels / (step * step)));
-  for (Instance& instance : instances_) {
-    if (instance.u.size() >= min_samples) people.push_back(observe(instance, camera));
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    Instance& instance = instances_[i];
+    if (instance.u.size() < min_samples) continue;
+    if (standout(instance, static_cast<std::int32_t>(i)) < params_.min_standout) continue;
+    people.push_back(observe(instance, camera));
   }
   // Fragments of one person (an arm cut off by its depth jump) join the larger part: pixel-
   // weighted centre, united box.
@@ -129,7 +155,9 @@ std::vector<PersonObservation> PersonDetector::detect(const cv::Mat& labels, int
   std::vector<PersonObservation> merged;
   for (const PersonObservation& part : people) {
     auto into = std::find_if(merged.begin(), merged.end(), [&](const PersonObservation& whole) {
-      return (whole.position_camera - part.position_camera).norm() < params_.merge_distance_m;
+      const Eigen::Vector3d apart = (whole.position_camera - part.position_camera).cwiseAbs();
+      return apart.x() < params_.merge_side_m && apart.y() < params_.merge_height_m &&
+             apart.z() < params_.merge_depth_m;
     });
     if (into == merged.end()) {
       merged.push_back(part);

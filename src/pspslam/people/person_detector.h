@@ -22,11 +22,21 @@ struct PersonDetectorParams {
   float depth_jump_abs_m = 0.15f;
   float depth_jump_rel = 0.05f;
   float max_depth_m = 10.0f;
-  // The camera sees a person's front surface; her centre lies this far behind it on the ray.
-  double body_radius_m = 0.10;
-  // Instances whose centres are closer than this are one person (an arm cut off the torso by
-  // its depth jump, a body split by an occluder).
-  double merge_distance_m = 0.45;
+  // The camera sees a person's front surface; her centre lies this far behind it on the ray
+  // (between the half depth and the half width of a torso: people are seen from any side).
+  double body_radius_m = 0.15;
+  // A person stands in front of what is behind her: around an instance (its box grown by
+  // standout_window of its size on each side) at least min_standout of the other samples with
+  // depth must lie farther than the depth jump behind its median depth. A segmentation that
+  // paints "person" on a wall or a poster lies at the depth of its surroundings and is dropped.
+  double standout_window = 0.3;
+  double min_standout = 0.35;
+  // Instances whose centres are this close along the camera's x (side), y (height) and z
+  // (depth) axes are one person: legs or an arm cut off the torso by their depth jump, a body
+  // split by an occluder. Two people side by side stand wider apart; one behind the other, deeper.
+  double merge_side_m = 0.35;
+  double merge_height_m = 1.0;
+  double merge_depth_m = 0.5;
 };
 
 // One person seen in one frame.
@@ -61,11 +71,14 @@ class PersonDetector {
   };
   void sample(const cv::Mat& labels, int person_label, const cv::Mat& depth);
   void label_components();
+  // The share of the samples around `instance` (id `id`) that lie behind it.
+  double standout(const Instance& instance, std::int32_t id) const;
   PersonObservation observe(Instance& instance, const PinholeCamera& camera) const;
 
   PersonDetectorParams params_;
   int grid_w_ = 0, grid_h_ = 0;
   std::vector<float> grid_depth_;      // per sample: depth of a person pixel, 0 otherwise
+  std::vector<float> all_depth_;       // per sample: its depth, 0 = no reading
   std::vector<std::int32_t> grid_id_;  // per sample: instance, -1 none
   std::vector<std::int32_t> queue_;
   std::vector<Instance> instances_;

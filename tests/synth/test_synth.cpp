@@ -177,7 +177,8 @@ TEST(SynthSequence, SameSeedWritesByteIdenticalFiles) {
     EXPECT_EQ(file_bytes(entry.path()), file_bytes(dir_b / relative)) << relative;
     ++files;
   }
-  EXPECT_EQ(files, 3u * 3u + 7u);  // rgb/depth/mask per frame; 4 lists, config, info, README
+  // rgb/depth/mask per frame; 4 lists, config, info, README, people.txt
+  EXPECT_EQ(files, 3u * 3u + 8u);
 }
 
 TEST(SynthScene, StaticTwinHasNoDynamicPixelsAndMatchesTheDynamicSequence) {

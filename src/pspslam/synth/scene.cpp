@@ -263,8 +263,9 @@ struct SyntheticScene::Impl {
   std::vector<Pose> static_poses;
   std::vector<synth::WalkingBody> bodies;
   std::vector<std::vector<BoxSurface>> body_boxes;  // per body, in WalkingBody::parts() order
-  std::vector<float> column_xn, row_yn;             // normalised ray coordinates of pixel centres
-  std::vector<float> ray_length;                    // |(x_n, y_n, 1)| per pixel, row-major
+  std::vector<int> person_of_box;  // per box of prepare_boxes(): its body, -1 static or carried
+  std::vector<float> column_xn, row_yn;  // normalised ray coordinates of pixel centres
+  std::vector<float> ray_length;         // |(x_n, y_n, 1)| per pixel, row-major
 
  private:
   // `static_pose`: the pose of a box that never moves, whose lighting is baked into its
@@ -340,6 +341,11 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
                                synth::mix_hash(body_seed, p), nullptr));
     }
     body_boxes.push_back(std::move(boxes));
+  }
+  person_of_box.assign(static_boxes.size(), -1);
+  for (size_t b = 0; b < body_boxes.size(); ++b) {
+    for (const BoxSurface& box : body_boxes[b])
+      person_of_box.push_back(box.label == kSynthLabelPerson ? static_cast<int>(b) : -1);
   }
 
   for (int x = 0; x < camera.width; ++x) {
@@ -773,6 +779,20 @@ double SyntheticScene::depth_time_offset(size_t index) const {
 }
 
 Pose SyntheticScene::T_body_camera() const { return impl_->T_body_camera; }
+
+int SyntheticScene::body_count() const { return static_cast<int>(impl_->bodies.size()); }
+
+Eigen::Vector3d SyntheticScene::body_centre_at(int body, double seconds) const {
+  std::vector<synth::BodyPartPose> parts;
+  impl_->bodies.at(static_cast<size_t>(body)).pose_parts(seconds, parts);
+  return parts.front().T_world_part.translation();  // the torso comes first
+}
+
+int SyntheticScene::person_of_surface(uint16_t surface_id) const {
+  if (surface_id == 0) return -1;
+  const size_t box = (surface_id - 1u) / 6u;
+  return box < impl_->person_of_box.size() ? impl_->person_of_box[box] : -1;
+}
 
 Pose SyntheticScene::ground_truth_pose(size_t index) const {
   return camera_pose(index) * impl_->T_body_camera.inverse();

@@ -111,6 +111,12 @@ class SyntheticScene {
   // into the body frame (identity unless kinect marker); ground_truth_pose = camera * inverse.
   Pose T_body_camera() const;
   Pose ground_truth_pose(size_t index) const;
+  // The walking people (synth/people_truth.h): how many; the centre of body `body`'s torso at
+  // `seconds` after the first frame (world); which body a SynthFrame::surface_ids value shows
+  // (-1: the static scene or a carried box).
+  int body_count() const;
+  Eigen::Vector3d body_centre_at(int body, double seconds) const;
+  int person_of_surface(uint16_t surface_id) const;
   // config.yaml of the sequence: synthetic_system_config() plus the lens distortion when the
   // kinect distortion fault is on; a stereo camera (type stereo, the baseline, depth threshold
   // 40 baselines) with --stereo.

@@ -17,6 +17,7 @@
 #include "pspslam/config/config.h"
 #include "pspslam/core/error.h"
 #include "pspslam/io/trajectory_io.h"
+#include "pspslam/synth/people_truth.h"
 
 namespace pspslam {
 namespace {
@@ -179,7 +180,9 @@ void write_readme(const fs::path& dir, const SyntheticScene& scene) {
       << "rgb.txt, depth.txt, mask.txt   TUM lists: timestamp path\n"
       << "groundtruth.txt  timestamp tx ty tz qx qy qz qw, camera-to-world, exact\n"
       << "config.yaml      camera config for 'pspslam run --sequence <this folder>'\n"
-      << "info.yaml        generator parameters\n";
+      << "info.yaml        generator parameters\n"
+      << "people.txt       every walking person at every frame: timestamp id, torso centre and\n"
+      << "                 velocity (world), pixels showing her (pspslam run scores its tracks)\n";
   if (scene.options().sensor == SynthSensor::kKinect) {
     out << "\nSensor: kinect, faults " << scene.options().faults.describe() << ":\n"
         << "depth noise 1.425e-3 z^2 m quantised to 1/8 px of disparity, holes (projector\n"
@@ -320,11 +323,16 @@ struct FrameImages {
   cv::Mat depth_u16, right, gray;
 };
 
+// Every frame's people (people.txt), filled by the workers, one slot per frame.
+using PeopleOfFrames = std::vector<std::vector<PersonTruth>>;
+
 // Renders frame i and writes its images in the sequence's layout.
-void write_frame(const SyntheticScene& scene, size_t i, const fs::path& dir, FrameImages& images) {
+void write_frame(const SyntheticScene& scene, size_t i, const fs::path& dir, FrameImages& images,
+                 PeopleOfFrames& people) {
   const bool stereo = scene.options().stereo_baseline > 0.0;
   SynthFrame& frame = images.frame;
   scene.render(i, frame, 1);
+  people[i] = people_truth(scene, frame);
   if (stereo) {
     scene.render_right(i, images.right, 1);
     cv::cvtColor(images.right, images.right, cv::COLOR_BGR2GRAY);
@@ -356,7 +364,8 @@ void write_frame(const SyntheticScene& scene, size_t i, const fs::path& dir, Fra
 
 // Whole frames per worker (render single-threaded + encode): PNG encoding dominates and
 // parallelises only across frames. The first error stops the workers and is rethrown.
-void write_frames(const SyntheticScene& scene, const fs::path& dir, const SynthProgress& progress) {
+void write_frames(const SyntheticScene& scene, const fs::path& dir, const SynthProgress& progress,
+                  PeopleOfFrames& people) {
   const size_t frames = scene.frame_count();
   const int requested = scene.options().threads;
   const size_t workers = std::max<size_t>(
@@ -374,7 +383,7 @@ void write_frames(const SyntheticScene& scene, const fs::path& dir, const SynthP
     FrameImages images;
     for (size_t i = next++; i < frames && !failed; i = next++) {
       try {
-        write_frame(scene, i, dir, images);
+        write_frame(scene, i, dir, images, people);
       } catch (...) {
         std::lock_guard lock(mutex);
         if (!first_error) first_error = std::current_exception();
@@ -432,7 +441,14 @@ void write_tum_files(const fs::path& dir, const SyntheticScene& scene) {
 void write_sequence(const SyntheticScene& scene, const fs::path& dir,
                     const SynthProgress& progress) {
   create_layout_folders(scene, dir);
-  write_frames(scene, dir, progress);
+  PeopleOfFrames people(scene.frame_count());
+  write_frames(scene, dir, progress, people);
+  if (scene.body_count() > 0) {
+    std::vector<PersonTruth> rows;
+    for (const std::vector<PersonTruth>& frame : people)
+      rows.insert(rows.end(), frame.begin(), frame.end());
+    write_people_truth(dir / "people.txt", rows);
+  }
   write_ground_truth(dir, scene);
   if (scene.options().layout == SynthOptions::Layout::euroc) {
     write_euroc_files(dir, scene);

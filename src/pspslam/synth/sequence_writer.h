@@ -17,7 +17,8 @@ using SynthProgress = std::function<void(size_t frames_done)>;
 //   rgb/<ts>.png, depth/<ts>.png (16-bit, 5000 per metre, 0 = no reading), mask/<ts>.png
 //   (8-bit kSynthLabel* values), rgb.txt, depth.txt, mask.txt, groundtruth.txt (camera-to-world),
 //   config.yaml (save_config of synthetic_system_config()), info.yaml (generator parameters),
-//   README.txt (what the files are).
+//   README.txt (what the files are), people.txt (with walking people: every person at every
+//   frame, synth/people_truth.h; in every layout).
 // With a stereo baseline also right/<ts>.png (8-bit grey, rectified right camera), right.txt,
 // config.yaml for the stereo camera and config_rgbd.yaml for the RGB-D one. With the KITTI
 // layout instead: image_0/, image_1/ (grey, %06d.png), times.txt, calib.txt, poses.txt,

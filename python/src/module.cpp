@@ -200,6 +200,20 @@ py::array_t<std::uint8_t> keypoint_fates(const std::vector<KeypointRecord>& reco
   return fates;
 }
 
+py::list people_list(const PeopleFrame& frame) {
+  py::list people;
+  for (const TrackedPerson& person : frame.people) {
+    py::dict entry;
+    entry["id"] = person.id;
+    entry["position"] = py::array_t<double>(3, person.position.data());
+    entry["velocity"] = py::array_t<double>(3, person.velocity.data());
+    entry["extent"] = person.extent_m;
+    entry["visible_pixels"] = person.visible_pixels;
+    people.append(entry);
+  }
+  return people;
+}
+
 void register_result(py::module_& m) {
   py::class_<PyResult>(m, "Result", "What track() made of one frame.")
       .def_property_readonly("timestamp", [](const PyResult& r) { return r.timestamp; })
@@ -244,6 +258,11 @@ void register_result(py::module_& m) {
           "restarted", [](const PyResult& r) { return r.report.tracking.restart_due; },
           "a monocular map was lost while young and starts anew: the poses "
           "so far belong to the old map")
+      .def_property_readonly(
+          "people", [](const PyResult& r) { return people_list(r.report.people); },
+          "the people tracked in this frame: a list of dicts with 'id', 'position' and "
+          "'velocity' (world frame of the map, metres and m/s), 'extent' (m) and "
+          "'visible_pixels'; empty without depth (monocular) or without the network's labels")
       .def_property_readonly("extraction_ms",
                              [](const PyResult& r) { return r.report.extraction_ms; })
       .def_property_readonly("tracking_ms", [](const PyResult& r) { return r.report.tracking_ms; })

@@ -7,19 +7,27 @@ import numpy as np
 import pspslam
 
 
-def test_trajectory_is_byte_identical_to_the_cli(synthetic_sequence, cli_run, tmp_path):
+def test_trajectory_and_people_are_those_of_the_cli(synthetic_sequence, cli_run, tmp_path):
     sequence = pspslam.read_sequence(synthetic_sequence)
-    timestamps, poses = [], []
+    timestamps, poses, people = [], [], []
     with pspslam.System(sequence) as slam:
         for frame, result in slam.track_frames(sequence):
             if result.pose is not None:
                 timestamps.append(frame.timestamp)
                 poses.append(result.pose)
+            people += [(frame.timestamp, p["id"], *p["position"], p["visible_pixels"])
+                       for p in result.people]
     ours = tmp_path / "trajectory.txt"
     pspslam.write_trajectory(ours, (np.array(timestamps), np.array(poses)))
     expected = (cli_run / "trajectory.txt").read_bytes()
     assert len(timestamps) > 50
     assert ours.read_bytes() == expected
+    # people.csv: frame,timestamp,id,x,y,z,vx,vy,vz,extent,visible_pixels
+    rows = [line.split(",") for line in (cli_run / "people.csv").read_text().splitlines()[1:]]
+    assert len(people) == len(rows) > 0
+    for ours_row, row in zip(people, rows):
+        assert ours_row[1] == int(row[2]) and ours_row[5] == int(row[10])
+        np.testing.assert_allclose(ours_row[2:5], [float(v) for v in row[3:6]], atol=1e-4)
 
 
 def test_numpy_frames_track_as_the_reader_frames(small_sequence, small_frames):

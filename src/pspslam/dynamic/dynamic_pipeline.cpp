@@ -126,7 +126,7 @@ cv::Mat DynamicPipeline::begin_frame(const InputFrame& frame, const cv::Mat& gra
   return {};
 }
 
-cv::Mat DynamicPipeline::mask_from_file(const InputFrame& frame, DynamicReport& report) const {
+cv::Mat DynamicPipeline::mask_from_file(const InputFrame& frame, DynamicReport& report) {
   const std::filesystem::path file = options_.semantic_masks / per_frame_png_name(frame.name);
   // Checked first: OpenCV would also print a warning of its own for a missing file.
   const cv::Mat image = std::filesystem::is_regular_file(file)
@@ -142,6 +142,7 @@ cv::Mat DynamicPipeline::mask_from_file(const InputFrame& frame, DynamicReport& 
                 std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows));
   }
   report.mask_age_frames = 0;
+  labels_ = image;  // a `pspslam synth` mask/ image is a label map (15 = person)
   return dilate_mask(image != 0, options_.semantic.mask_dilation_px);
 }
 

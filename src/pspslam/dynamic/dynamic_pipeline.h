@@ -189,9 +189,10 @@ class DynamicPipeline {
 
   // The fused semantic + geometry mask of the frame end_frame() finished last.
   const cv::Mat& fused_mask() const { return previous_mask_; }
-  // Class labels (CV_8UC1) of the segmentation whose mask the last begin_frame() used; empty
-  // without one. In --realtime runs they may be of an earlier frame (the mask was warped, the
-  // labels are not). Shared with the semantic thread's result, not copied.
+  // Class labels (CV_8UC1) of the segmentation whose mask the last begin_frame() used (with
+  // DynamicOptions::semantic_masks: the mask file as read); empty without one. In --realtime runs
+  // they may be of an earlier frame (the mask was warped, the labels are not). Shared with the
+  // semantic thread's result, not copied.
   const cv::Mat& semantic_labels() const { return labels_; }
 
   // The geometry stage's tested points, path and grown regions of the last remove_dynamic()
@@ -213,7 +214,7 @@ class DynamicPipeline {
     std::chrono::steady_clock::time_point time;
   };
 
-  cv::Mat mask_from_file(const InputFrame& frame, DynamicReport& report) const;
+  cv::Mat mask_from_file(const InputFrame& frame, DynamicReport& report);
   cv::Mat semantic_mask(DynamicReport& report);
   // A live run's older mask moved into the current frame (StaleMaskPolicy::flow).
   cv::Mat propagate_mask(const SemanticResult& result, DynamicReport& report);

@@ -495,6 +495,21 @@ void add_ate_json(const RunAte& ates, bool monocular, nlohmann::ordered_json& js
   }
 }
 
+// One line on the people tracked (people.csv), with their score where the sequence has a truth.
+void print_people(const nlohmann::ordered_json& people, std::ostream& out) {
+  out << "people:       " << people["tracks"].get<int>() << " tracks, "
+      << people["rows"].get<size_t>() << " rows in people.csv";
+  if (people.contains("score")) {
+    const nlohmann::ordered_json& score = people["score"];
+    out << fmt::format(
+        "; {:.1f} % of person-frames tracked, median error {:.0f} mm, {} id switches, "
+        "{:.1f} % false",
+        score["tracked_percent"].get<double>(), score["position_error_mm_median"].get<double>(),
+        score["id_switches"].get<int>(), score["false_percent"].get<double>());
+  }
+  out << "\n";
+}
+
 nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSections& reported) {
   const RunStatistics& stats = input.statistics;
   const SystemOptions& system = input.options.system;
@@ -532,6 +547,7 @@ nlohmann::ordered_json stats_json(const RunReportInput& input, const ReportedSec
   json["atlas"] = atlas_json(input.atlas);
   add_ate_json(reported.ate, monocular, json);
   json["occupancy"] = input.occupancy != nullptr ? *input.occupancy : nlohmann::ordered_json();
+  if (input.people) json["people"] = *input.people;
   return json;
 }
 
@@ -558,6 +574,7 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   reported.live_masks = report_live_masks(input, out);
   reported.source = input.source.stats();
   if (reported.source.disconnected) out << "input:        " << reported.source.end_reason << "\n";
+  if (input.people) print_people(*input.people, out);
 
   const nlohmann::ordered_json json = stats_json(input, reported);
   std::ofstream file = open_output(out_dir / "stats.json");

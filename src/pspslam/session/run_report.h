@@ -36,6 +36,8 @@ struct RunReportInput {
   DynamicMode requested_mode = DynamicMode::off;
   std::string dynamic_note;
   const nlohmann::ordered_json* occupancy = nullptr;  // stats.json "occupancy"; null: none
+  // stats.json "people" (session/people_log.h); null: the run tracked no people.
+  const nlohmann::ordered_json* people = nullptr;
 };
 
 // The run's summary: printed to `out` (frames, speed, map, loops, ATE against the sequence's

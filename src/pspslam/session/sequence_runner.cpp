@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <iostream>
@@ -106,6 +108,7 @@ SequenceRunner::SequenceRunner(RunInput input, RunOptions options, std::ostream&
   if (input_.config.camera.fps > 0.0)
     options_.system.dynamic.frame_period_ms = 1000.0 / input_.config.camera.fps;
   system_ = std::make_unique<System>(input_.config, options_.system);
+  if (system_->tracks_people()) people_log_.emplace(options_.outputs.folder);
   if (!options_.outputs.export_map.empty() || !options_.outputs.export_dense.empty())
     exporter_.emplace(input_.config.camera.pinhole);
   if (options_.occupancy.enabled)
@@ -226,10 +229,12 @@ MappingStats SequenceRunner::record_frame(const InputFrame& frame, const FrameRe
   const LocalBaTime local_ba{mapping.local_ba_ms_total - mapping_before.local_ba_ms_total,
                              mapping.local_ba_cpu_ms_total - mapping_before.local_ba_cpu_ms_total};
   log_.write(frame.index, frame.timestamp, report, local_ba.wall_ms, mapping, arrival_to_pose_ms);
+  if (people_log_) people_log_->write(frame.index, frame.timestamp, report.people);
   if (result.restart_due) {
     // The new map has its own world frame and scale: the old poses would corrupt the file.
     log_.forget_poses();
     estimate_.clear();
+    if (people_log_) people_log_->forget_rows();
   }
   statistics_.add_frame(frame.index, report, local_ba);
   mapping_before = mapping;
@@ -302,6 +307,10 @@ void SequenceRunner::finish(double seconds) {
                            .merges = mapping.map_merges,
                            .maps_at_end = mapping.maps,
                            .final_maps = final_maps};
+  const nlohmann::ordered_json people =
+      people_log_
+          ? people_log_->summary(options_.sequence, input_.source->ground_truth(), estimate_)
+          : nlohmann::ordered_json();
   write_run_report({.options = options_,
                     .statistics = statistics_,
                     .mapping = mapping,
@@ -317,7 +326,8 @@ void SequenceRunner::finish(double seconds) {
                     .config_file = input_.config_file,
                     .requested_mode = limits_.requested_mode,
                     .dynamic_note = limits_.dynamic_note,
-                    .occupancy = occupancy_ ? &occupancy_->json() : nullptr},
+                    .occupancy = occupancy_ ? &occupancy_->json() : nullptr,
+                    .people = people_log_ ? &people : nullptr},
                    out_);
 }
 

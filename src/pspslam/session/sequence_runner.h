@@ -11,6 +11,7 @@
 #include "pspslam/io/frame_source.h"
 #include "pspslam/session/frame_images.h"
 #include "pspslam/session/frame_log.h"
+#include "pspslam/session/people_log.h"
 #include "pspslam/session/run_input.h"
 #include "pspslam/session/run_observer.h"
 #include "pspslam/session/run_options.h"
@@ -73,7 +74,8 @@ class SequenceRunner {
   size_t delivered_ = 0;  // frames taken from the source
   std::optional<Timestamp> blackout_return_;
   FrameLog log_;
-  FrameImageWriter images_;  // --save-masks / --save-overlays
+  std::optional<PeopleLog> people_log_;  // runs that track people (System::tracks_people)
+  FrameImageWriter images_;              // --save-masks / --save-overlays
   std::unique_ptr<System> system_;
   std::optional<MapExporter> exporter_;      // with --export-map / --export-dense
   std::unique_ptr<OccupancyRun> occupancy_;  // with --occupancy

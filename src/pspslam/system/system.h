@@ -85,6 +85,8 @@ class System {
   // Class labels (CV_8UC1) of the segmentation used for the frame process() handled last; empty
   // without semantics or a mask. Shared, not copied.
   cv::Mat last_semantic_labels() const { return tracking_->last_semantic_labels(); }
+  // Whether frames report their people (FrameReport::people): a person class and depth exist.
+  bool tracks_people() const { return tracking_->tracks_people(); }
   // The geometry stage's picture of the frame process() handled last (tested points, path,
   // grown regions); empty unless keypoint fates were recorded for that frame; null with
   // DynamicMode::off.

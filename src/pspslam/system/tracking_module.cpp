@@ -13,6 +13,7 @@
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/place/place_recognition.h"
+#include "pspslam/semantic/segmenter_metadata.h"
 #include "pspslam/system/frame_builder.h"
 
 namespace pspslam {
@@ -38,6 +39,24 @@ std::unique_ptr<DynamicPipeline> make_dynamic_pipeline(const SystemConfig& confi
   return std::make_unique<DynamicPipeline>(dynamic, config.camera.pinhole, map);
 }
 
+// People are tracked where each frame's persons are labelled (the network, or mask files) and
+// the sensor gives depth.
+std::unique_ptr<PeopleTracking> make_people_tracking(const SystemConfig& config,
+                                                     const SystemOptions& options) {
+  const DynamicOptions& dynamic = options.dynamic;
+  if (!uses_semantics(dynamic.mode) || config.camera.type == SensorType::monocular) return nullptr;
+  // Masks read from files are taken as label maps with PASCAL VOC's person id, as the masks of
+  // `pspslam synth` are (kSynthLabelPerson).
+  constexpr int kVocPerson = 15;
+  if (!dynamic.semantic_masks.empty())
+    return std::make_unique<PeopleTracking>(config.camera.pinhole, kVocPerson);
+  const std::vector<std::string> classes = load_segmenter_metadata(dynamic.model).classes;
+  const auto person = std::find(classes.begin(), classes.end(), "person");
+  if (person == classes.end()) return nullptr;
+  return std::make_unique<PeopleTracking>(config.camera.pinhole,
+                                          static_cast<int>(person - classes.begin()));
+}
+
 cv::Mat grey_image(const InputFrame& frame) {
   if (!frame.gray.empty()) return frame.gray;
   cv::Mat gray;
@@ -60,7 +79,8 @@ TrackingModule::TrackingModule(const SystemConfig& config, const SystemOptions& 
                frame_builder_->make_map_initializer(tracker_options(config, options))),
       extractor_(std::make_unique<OrbExtractor>(read_orb_config(config.orb))),
       record_keypoint_fates_(options.record_keypoint_fates),
-      dynamic_(make_dynamic_pipeline(config, options, map)) {}
+      dynamic_(make_dynamic_pipeline(config, options, map)),
+      people_(make_people_tracking(config, options)) {}
 
 TrackingModule::~TrackingModule() = default;
 
@@ -121,6 +141,15 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
     dynamic_->end_frame(report.tracking, depth, semantic_mask, report.dynamic);
   }
   if (fates) record_fates_of_tracked_frame(*fates);
+  // 7. People: this frame's own person labels (a stale mask's are of another frame), its depth
+  // and pose give each person's centre; tracks link them over frames.
+  if (people_) {
+    if (report.tracking.restart_due) people_->reset();
+    const bool own_labels = report.dynamic.mask_age_frames == 0;
+    report.people =
+        people_->process(frame.timestamp, own_labels ? dynamic_->semantic_labels() : cv::Mat(),
+                         depth, report.tracking.T_world_camera);
+  }
   return report;
 }
 

@@ -11,6 +11,7 @@
 #include "pspslam/dynamic/dynamic_pipeline.h"
 #include "pspslam/feature/orb_extractor.h"
 #include "pspslam/io/input_frame.h"
+#include "pspslam/people/people_tracking.h"
 #include "pspslam/system/system_options.h"
 #include "pspslam/tracking/tracker.h"
 
@@ -34,6 +35,9 @@ struct FrameReport {
   // Every keypoint of the frame and what became of it; empty unless
   // SystemOptions::record_keypoint_fates.
   std::vector<KeypointRecord> keypoints;
+  // The people tracked in this frame (empty without depth or a person class: monocular, masks
+  // read from files, --dynamic off or geometry).
+  PeopleFrame people;
 };
 
 // What the tracking module needs from the threads behind it; System provides both. The defaults
@@ -85,6 +89,7 @@ class TrackingModule {
     return dynamic_ ? &dynamic_->geometry_picture() : nullptr;
   }
   const Tracker& tracker() const { return tracker_; }
+  bool tracks_people() const { return people_ != nullptr; }
 
  private:
   // TrackResult::restart_due: local mapping finishes, the map and the keyframe database are
@@ -116,6 +121,9 @@ class TrackingModule {
   // Semantic thread, geometry stage and their per-frame state; null with DynamicMode::off.
   // Declared last: its threads stop before the tracker goes away.
   std::unique_ptr<DynamicPipeline> dynamic_;
+  // After the dynamic pipeline: it reads that pipeline's labels. Null where no person mask or
+  // depth exists.
+  std::unique_ptr<PeopleTracking> people_;
 };
 
 }  // namespace pspslam

@@ -11,7 +11,8 @@
 //   trajectory_refined.txt  the final trajectory, written at the end: the frames of
 //                    trajectory.txt moved with the BA-refined keyframes around them in time
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
-//                    dynamic-scene stages (mask age, geometry time, masked keypoints)
+//                    dynamic-scene stages (mask age, geometry time, masked keypoints), the
+//                    map's keyframes and points, resident memory
 //   stats.json       run summary: frames, lost frames, fps, per-module timing {median, mean,
 //                    p95}, dynamic-feature totals, mode, mask latency, ATE (with ground truth);
 //                    written also when the run is interrupted (Ctrl-C / SIGTERM)

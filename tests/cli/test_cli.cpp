@@ -756,14 +756,24 @@ TEST(CliRun, RealtimeRunReportsArrivalToPoseLatency) {
     const nlohmann::json stats = nlohmann::json::parse(in);
     return std::tuple{stats["latency"], stats["frames"].get<int>(), stats["scheduling"]};
   };
-  // timing.csv's last column: each frame's arrival to pose, empty without an arrival.
+  // timing.csv: each frame's arrival to pose, empty without an arrival, then the map's size and
+  // the resident memory.
   const auto arrival_column = [&](const std::string& name) {
     std::ifstream in(dir / name / "timing.csv");
     std::string header;
     std::getline(in, header);
-    EXPECT_TRUE(header.ends_with(",arrival_to_pose_ms")) << header;
+    EXPECT_TRUE(header.ends_with(",arrival_to_pose_ms,keyframes_in_map,map_points,rss_mib"))
+        << header;
     std::vector<std::string> values;
-    for (std::string row; std::getline(in, row);) values.push_back(row.substr(row.rfind(',') + 1));
+    for (std::string row; std::getline(in, row);) {
+      std::vector<std::string> fields;
+      std::stringstream stream(row);
+      for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
+      EXPECT_EQ(fields.size(), 25u) << row;
+      if (fields.size() != 25u) continue;
+      EXPECT_GT(std::stod(fields[24]), 1.0) << row;  // resident memory, MiB
+      values.push_back(fields[21]);
+    }
     return values;
   };
   const auto [realtime, processed, live_scheduling] =

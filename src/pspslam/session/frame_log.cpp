@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include <unistd.h>
+
 #include "pspslam/core/error.h"
 
 namespace pspslam {
@@ -28,7 +30,7 @@ FrameLog::FrameLog(const std::filesystem::path& folder)
       << "index,timestamp,state,method,keypoints,inliers,keyframe,extraction_ms,tracking_ms,"
          "local_ba_ms,mapping_queue,extraction_cpu_ms,tracking_cpu_ms,flow_ms,semantic_wait_"
          "ms,mask_age,geometry_ms,tested,dynamic,masked_keypoints,culled_points,arrival_to_pose_"
-         "ms\n";
+         "ms,keyframes_in_map,map_points,rss_mib\n";
 }
 
 void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& report,
@@ -59,7 +61,30 @@ void FrameLog::write(size_t index, Timestamp timestamp, const FrameReport& repor
     std::snprintf(row, sizeof(row), "%.3f", *arrival_to_pose_ms);
     timing_ << row;
   }
-  timing_ << '\n';
+  std::snprintf(row, sizeof(row), ",%zu,%zu,%.1f\n", mapping.keyframes_in_map, mapping.map_points,
+                resident_mib());
+  timing_ << row;
+}
+
+double FrameLog::resident_mib() {
+  const auto now = std::chrono::steady_clock::now();
+  if (!resident_read_at_ || now - *resident_read_at_ >= std::chrono::seconds(1)) {
+    resident_mib_ = read_resident_mib();
+    resident_read_at_ = now;
+  }
+  return resident_mib_;
+}
+
+double read_resident_mib() {
+  std::FILE* file = std::fopen("/proc/self/statm", "r");
+  if (file == nullptr) return 0.0;
+  unsigned long size = 0;
+  unsigned long resident = 0;
+  const int read = std::fscanf(file, "%lu %lu", &size, &resident);
+  std::fclose(file);
+  if (read != 2) return 0.0;
+  const long page = sysconf(_SC_PAGESIZE);
+  return static_cast<double>(resident) * static_cast<double>(page) / (1024.0 * 1024.0);
 }
 
 void FrameLog::write_lost(const LostLine& line) {

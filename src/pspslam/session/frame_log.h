@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
@@ -22,7 +23,9 @@ namespace pspslam {
 //   timing.csv       per frame, as it was processed (a frame placed later keeps its
 //                    not_initialized row): extraction / tracking / local BA milliseconds, state,
 //                    the dynamic-scene stages (mask age, geometry time, masked keypoints) and,
-//                    for frames that arrived live (--realtime, a camera), arrival to pose
+//                    for frames that arrived live (--realtime, a camera), arrival to pose;
+//                    then keyframes and map points in the map as of the frame, and the
+//                    process's resident memory in MiB (read at most once a second)
 class FrameLog {
  public:
   // Creates the three files in `folder` (which must exist); throws pspslam::Error naming a file
@@ -58,7 +61,14 @@ class FrameLog {
   std::vector<LostLine> lost_lines_;  // every line of lost_, so that it can be rewritten
   std::ofstream lost_;
   std::ofstream timing_;
+  // Resident memory is read from /proc at most once a second, not per frame.
+  double resident_mib_ = 0.0;
+  std::optional<std::chrono::steady_clock::time_point> resident_read_at_;
+  double resident_mib();
 };
+
+// The process's resident set size in MiB (/proc/self/statm); 0 where it cannot be read.
+double read_resident_mib();
 
 // Opens `file` for writing; throws pspslam::Error naming it when it cannot.
 std::ofstream open_output(const std::filesystem::path& file);

@@ -46,8 +46,9 @@ void add_scene_options(CLI::App* app, SynthFlags& flags) {
       ->capture_default_str();
   app->add_option("--loop-turns", options.loop_turns,
                   "turns of the loop trajectory (1.08 revisits the start briefly; 1.5 gives half "
-                  "a turn of revisit, enough for covisibility-consistent loop detection)")
-      ->check(in_range(0.01, 10.0))
+                  "a turn of revisit, enough for covisibility-consistent loop detection; a patrol "
+                  "of hours takes hundreds)")
+      ->check(in_range(0.01, 1000.0))
       ->capture_default_str();
 }
 

@@ -197,8 +197,8 @@ void SynthOptions::validate() const {
   }
   if (threads < 0)
     throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
-  if (!(loop_turns > 0.0 && loop_turns <= 10.0))
-    throw Error("synth: flag --loop-turns must be in (0, 10], got " + std::to_string(loop_turns));
+  if (!(loop_turns > 0.0 && loop_turns <= 1000.0))
+    throw Error("synth: flag --loop-turns must be in (0, 1000], got " + std::to_string(loop_turns));
   if (!(stereo_baseline >= 0.0 && stereo_baseline <= 2.0))
     throw Error("synth: flag --stereo must be a baseline in metres in (0, 2], got " +
                 std::to_string(stereo_baseline));

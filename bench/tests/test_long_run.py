@@ -79,3 +79,18 @@ def test_a_bad_ground_truth_is_named(tmp_path):
     assert result.returncode == 2
     assert result.stderr == (f"long_run.py: {sequence / 'groundtruth.txt'}: expected 8 columns "
                              "(t tx ty tz qx qy qz qw), got 3\n")
+
+
+def test_the_plot_is_written_as_a_png(tmp_path):
+    run, sequence = make_run(tmp_path)
+    picture = tmp_path / "long_run.png"
+    result = tool(run, "--sequence", sequence, "--minute-frames", 3, "--plot", picture)
+    assert result.returncode == 0, result.stderr
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_window_of_no_frames_is_refused(tmp_path):
+    run, sequence = make_run(tmp_path)
+    result = tool(run, "--sequence", sequence, "--minute-frames", 0)
+    assert result.returncode == 2
+    assert result.stderr.endswith("error: --minute-frames: must be at least 1, got 0\n")

@@ -154,6 +154,7 @@ def window_rows(timing, online, refined, minute_frames):
             row[f"{label}_ate_mm"] = float(np.sqrt(np.mean(inside ** 2)) * 1e3) if inside.size else None
             row[f"{label}_max_mm"] = float(inside.max() * 1e3) if inside.size else None
         end = np.where(here)[0][-1]
+        row["end_s"] = float(timing["timestamp"][end] - timing["timestamp"][0])
         for name in ("keyframes_in_map", "map_points", "rss_mib"):
             row[name] = float(timing[name][end])
         latency = timing["arrival_to_pose_ms"][here]
@@ -179,11 +180,11 @@ def markdown(rows, minute_frames):
     return "\n".join(lines) + "\n"
 
 
-def plot(rows, fps, path):
+def plot(rows, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    minutes = [row["last"] / fps / 60 for row in rows]
+    minutes = [row["end_s"] / 60 for row in rows]
     figure, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     for label in ("online", "refined"):
         axes[0].plot(minutes, [row[f"{label}_ate_mm"] for row in rows], "o-", label=f"{label} ATE")
@@ -194,7 +195,7 @@ def plot(rows, fps, path):
     axes[1].set_ylabel("keyframes in map")
     axes[2].plot(minutes, [row["rss_mib"] for row in rows], "o-")
     axes[2].set_ylabel("resident memory (MiB)")
-    axes[2].set_xlabel("time at the end of the window (min)")
+    axes[2].set_xlabel("time at the window's last frame (min)")
     figure.tight_layout()
     figure.savefig(path)
 
@@ -210,7 +211,7 @@ def report(run, sequence, minute_frames):
                                                                  timing["timestamp"])}
     errors = [position_errors(run / name, frame_of_stamp, gt_stamps, gt_positions)
               for name in ("trajectory.txt", "trajectory_refined.txt")]
-    return window_rows(timing, errors[0], errors[1], minute_frames), timing
+    return window_rows(timing, errors[0], errors[1], minute_frames)
 
 
 def main(argv=None):
@@ -227,7 +228,7 @@ def main(argv=None):
     if args.minute_frames < 1:
         parser.error(f"--minute-frames: must be at least 1, got {args.minute_frames}")
     try:
-        rows, timing = report(args.run, args.sequence, args.minute_frames)
+        rows = report(args.run, args.sequence, args.minute_frames)
     except InputError as error:
         print(f"long_run.py: {error}", file=sys.stderr)
         return 2
@@ -236,9 +237,7 @@ def main(argv=None):
     if args.markdown:
         args.markdown.write_text(table)
     if args.plot:
-        stamps = timing["timestamp"]
-        fps = (len(stamps) - 1) / (stamps[-1] - stamps[0]) if len(stamps) > 1 else 30.0
-        plot(rows, fps, args.plot)
+        plot(rows, args.plot)
     return 0
 
 

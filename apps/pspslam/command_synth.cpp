@@ -41,6 +41,10 @@ void add_scene_options(CLI::App* app, SynthFlags& flags) {
   app->add_option("--seed", options.seed, "random seed: same seed, same bytes")
       ->check(in_range(uint64_t{0}, uint64_t{4294967295}))
       ->capture_default_str();
+  app->add_option("--stand-seconds", options.stand_seconds,
+                  "people stand where they start for this long, then walk")
+      ->check(in_range(0.0, 3600.0))
+      ->capture_default_str();
   app->add_option("--trajectory", flags.trajectory, "camera motion")
       ->check(CLI::IsMember({"handheld", "loop"}))
       ->capture_default_str();

@@ -14,7 +14,7 @@ MODES = ("off", "semantic", "geometry", "full", "exhaustive")
 METRICS = ("online", "final")
 SYNTH_KEYS = {"frames": int, "bodies": int, "seed": int, "trajectory": str, "loop_turns": float,
               "sensor": str, "stereo": float, "layout": str, "depth_noise": str,
-              "carried_objects": int, "occupancy_truth": float}
+              "carried_objects": int, "occupancy_truth": float, "stand_seconds": float}
 
 
 class ExperimentError(Exception):

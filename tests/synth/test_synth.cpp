@@ -275,6 +275,26 @@ TEST(SynthMotion, PeopleWalkAtHumanSpeedsAndAreAboutOnePointSevenMetresTall) {
   }
 }
 
+TEST(SynthMotion, APersonWhoStandsFirstStaysPutThenWalksTheSameLap) {
+  const synth::RoomLayout room;
+  const synth::WalkingBody walker(1, 7, false, room, 0.7);
+  const synth::WalkingBody stander(1, 7, false, room, 0.7, 2.0);
+  std::vector<synth::BodyPartPose> start, now, walking;
+  stander.pose_parts(0.0, start);
+  for (const double t : {0.5, 1.0, 2.0}) {
+    stander.pose_parts(t, now);
+    EXPECT_TRUE(now[0].T_world_part.isApprox(start[0].T_world_part)) << "t " << t;
+  }
+  // After standing, the same lap as the walker's, two seconds later.
+  for (const double walked : {0.5, 3.0}) {
+    stander.pose_parts(2.0 + walked, now);
+    walker.pose_parts(walked, walking);
+    EXPECT_TRUE(now[0].T_world_part.isApprox(walking[0].T_world_part)) << "walked " << walked;
+  }
+  stander.pose_parts(2.5, now);
+  EXPECT_GT((now[0].T_world_part.translation() - start[0].T_world_part.translation()).norm(), 0.2);
+}
+
 TEST(SynthMotion, CameraMovesSmoothlyAndTheLoopRevisitsItsStart) {
   for (const SynthTrajectory kind : {SynthTrajectory::kHandheld, SynthTrajectory::kLoop}) {
     SynthOptions options = small_options(0);
@@ -485,6 +505,12 @@ TEST(SynthOptions, InvalidValuesAreRejectedNamingTheFlag) {
   options = SynthOptions{};
   options.frames = 0;
   EXPECT_NE(message_of([&] { options.validate(); }).find("--frames must be >= 1, got 0"),
+            std::string::npos);
+  options = SynthOptions{};
+  options.stand_seconds = -1.0;
+  EXPECT_NE(message_of([&] {
+              options.validate();
+            }).find("--stand-seconds must be in [0, 3600], got -1.000000"),
             std::string::npos);
   EXPECT_NE(message_of([] {
               parse_synth_trajectory("circle");

@@ -94,8 +94,11 @@ Pose CameraPath::T_world_camera(double t) const {
 }
 
 WalkingBody::WalkingBody(int index, uint64_t seed, bool carries_box, const RoomLayout& room,
-                         std::optional<double> sector_centre_angle)
-    : carries_box_(carries_box), centre_(room.floor_centre()), sector_centre_(sector_centre_angle) {
+                         std::optional<double> sector_centre_angle, double stand_s)
+    : carries_box_(carries_box),
+      centre_(room.floor_centre()),
+      sector_centre_(sector_centre_angle),
+      stand_s_(stand_s) {
   const uint64_t body_seed = mix_hash(seed, 0xB0D1u, static_cast<uint64_t>(index));
   if (sector_centre_) {
     // Spread people over the sector; a person beyond the third reuses a lane, shifted.
@@ -157,12 +160,13 @@ double WalkingBody::tau_at_distance(double distance_m) const {
 }
 
 void WalkingBody::pose_parts(double t, std::vector<BodyPartPose>& out) const {
-  const double distance = start_m_ + direction_ * speed_ * t;
+  const double walked_s = std::max(0.0, t - stand_s_);
+  const double distance = start_m_ + direction_ * speed_ * walked_s;
   const Eigen::Vector2d position = path_point(tau_at_distance(distance));
   const Eigen::Vector2d ahead = path_point(tau_at_distance(distance + direction_ * 0.05));
   const double heading = std::atan2(ahead.y() - position.y(), ahead.x() - position.x());
   constexpr double kStrideCycle_m = 1.3;  // one full gait cycle (two steps)
-  const double gait = 2.0 * kPi * speed_ * t / kStrideCycle_m;
+  const double gait = 2.0 * kPi * speed_ * walked_s / kStrideCycle_m;
   const double bob = 0.012 * (1.0 - std::cos(2.0 * gait));
 
   Pose T_world_body = Pose::Identity();

@@ -62,8 +62,9 @@ enum class BodyPart { kTorso, kHead, kLeftArm, kRightArm, kLeftLeg, kRightLeg, k
 // back along a near one, passing about 1 m from the camera, as people do in front of a camera.
 class WalkingBody {
  public:
+  // `stand_s`: the person stands at the path's start for this long, then walks.
   WalkingBody(int index, uint64_t seed, bool carries_box, const RoomLayout& room,
-              std::optional<double> sector_centre_angle = std::nullopt);
+              std::optional<double> sector_centre_angle = std::nullopt, double stand_s = 0.0);
 
   bool carries_box() const { return carries_box_; }
   const std::vector<BodyPart>& parts() const { return parts_; }
@@ -82,6 +83,7 @@ class WalkingBody {
   double radius_, radius_swing_, wobble_phase_;
   double direction_;  // +1 or -1: which way round the lap
   double start_m_;    // where on the lap the person is at t = 0
+  double stand_s_;    // seconds stood still before walking
   double speed_;
   double scale_;                      // body height / 1.72 m
   std::vector<double> lap_distance_;  // arc length at tau = 2 pi k / (n - 1), for constant speed

@@ -197,6 +197,10 @@ void SynthOptions::validate() const {
   }
   if (threads < 0)
     throw Error("synth: flag --threads must be >= 0, got " + std::to_string(threads));
+  if (!(stand_seconds >= 0.0 && stand_seconds <= 3600.0)) {
+    throw Error("synth: flag --stand-seconds must be in [0, 3600], got " +
+                std::to_string(stand_seconds));
+  }
   if (!(loop_turns > 0.0 && loop_turns <= 1000.0))
     throw Error("synth: flag --loop-turns must be in (0, 1000], got " + std::to_string(loop_turns));
   if (!(stereo_baseline >= 0.0 && stereo_baseline <= 2.0))
@@ -319,7 +323,8 @@ SyntheticScene::Impl::Impl(const SynthOptions& opts)
     const std::optional<double> sector = opts.trajectory == SynthTrajectory::kHandheld
                                              ? std::optional<double>(camera_path.mean_heading())
                                              : std::nullopt;
-    bodies.emplace_back(b, opts.seed, b < options.carried_objects, room, sector);
+    bodies.emplace_back(b, opts.seed, b < options.carried_objects, room, sector,
+                        options.stand_seconds);
     const uint64_t body_seed = synth::mix_hash(opts.seed, 0xB0D7u, static_cast<uint64_t>(b));
     const BodyLook look = body_look(body_seed);
     std::vector<synth::BodyPartPose> rest;

@@ -47,6 +47,9 @@ struct SynthOptions {
   int bodies = 3;           // walking people; 0 = the static twin (same room, same camera path)
   int carried_objects = 1;  // people carrying a box; clamped to `bodies`
   uint64_t seed = 1;
+  // People stand where they start for this long, then walk: points made on a person who stood
+  // still must leave the map once she moves.
+  double stand_seconds = 0.0;
   SynthTrajectory trajectory = SynthTrajectory::kHandheld;
   double loop_turns = 1.08;  // turns of the loop trajectory (> 1: the start is revisited)
   // Kinect-like sensor: noise growing with depth squared plus holes (range limits, grazing

@@ -253,9 +253,14 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     }
     last_pose_ = result.T_world_camera;
     last_pose_id_ = current_id_;
-    const cv::Mat cull_mask = culling_mask(report);
-    if (!cull_mask.empty() && !protect_map_)
+    if (options_.culling.evidence == CullingEvidence::none) {
+      // Nothing to judge: no mask is fused for culling.
+    } else if (culls_by_sight()) {
+      if (!protect_map_) report.culled_map_points += cull(*result.T_world_camera, {}, depth);
+    } else if (const cv::Mat cull_mask = culling_mask(report);
+               !cull_mask.empty() && !protect_map_) {
       report.culled_map_points += cull(*result.T_world_camera, cull_mask, depth);
+    }
   }
 }
 
@@ -270,6 +275,12 @@ int DynamicPipeline::cull(const Pose& T_world_camera, const cv::Mat& mask, const
     for (const auto& point : culled) map_.erase_map_point(point);
   }
   return static_cast<int>(culled.size());
+}
+
+// Culling by what the frame's depth sees, whatever the masks (CullingEvidence::seen_through).
+bool DynamicPipeline::culls_by_sight() const {
+  return options_.mode != DynamicMode::off &&
+         options_.culling.evidence == CullingEvidence::seen_through;
 }
 
 // A live run culling on exact masks only, whose mask for this frame is stale: only late masks,
@@ -331,6 +342,8 @@ void DynamicPipeline::judge_late_frame(const SemanticResult& result, DynamicRepo
   const std::optional<SegmentedFrame> frame = late_mask_frames_.take(result.frame_id);
   if (!frame || protect_map_ || frame->map_id != map_.active_map()) return;
   report.late_frame_judged = true;
+  // Seen-through evidence judged that frame when it was tracked; a mask adds nothing to it.
+  if (options_.culling.evidence != CullingEvidence::dynamic_pixels) return;
   report.culled_by_late_mask = cull(frame->T_world_camera, result.dynamic_mask, frame->depth);
   report.culled_map_points += report.culled_by_late_mask;
 }

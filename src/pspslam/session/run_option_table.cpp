@@ -355,8 +355,16 @@ void add_map_options(std::vector<RunOption>& table) {
       "localisation only (needs --load-map): track in the map, never add to it", false));
   table.push_back(number_option<&RunSettings::cull_hits>(
       "--cull-hits", "cull_hits",
-      "erase a map point after it lay on dynamic pixels in this many frames", Kind::integer, 1,
-      1000));
+      "with --cull-evidence mask or seen-through: erase a map point after this many frames of "
+      "evidence against it",
+      Kind::integer, 1, 1000));
+  table.push_back(choice_option<&RunSettings::cull_evidence>(
+      "--cull-evidence", "cull_evidence",
+      "what erases a map point as dynamic: off (nothing; local mapping's own culling removes "
+      "points that stop being matched), mask (it lies on the frame's dynamic mask at its own "
+      "depth) or seen-through (the frame's depth sees through where the map has it, whatever the "
+      "masks); see docs/decisions/map-hygiene.md",
+      {"off", "mask", "seen-through"}));
 }
 
 std::vector<RunOption> make_table() {

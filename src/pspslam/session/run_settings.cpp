@@ -49,6 +49,8 @@ void set_dynamic(const RunSettings& settings, const SettingNames& names, Dynamic
   dynamic.semantic.mask_dilation_px = settings.mask_margin;
   dynamic.segment_every = settings.segment_every;
   dynamic.culling.min_dynamic_hits = settings.cull_hits;
+  dynamic.culling.evidence = parse_culling_evidence(
+      settings.cull_evidence, names.keywords ? "cull_evidence" : "--cull-evidence");
 }
 
 // A live run's answers to a network that falls behind the camera.

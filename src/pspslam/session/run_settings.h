@@ -52,6 +52,7 @@ struct RunSettings {
   int mask_margin = 5;
   int segment_every = 1;
   int cull_hits = 3;
+  std::string cull_evidence = "off";  // off | mask | seen-through (CullingEvidence)
   double keyframe_ratio = KeyFramePolicyOptions{}.tracked_ratio_to_reference;
   bool due_keyframes = false;
   std::optional<int> local_ba_keyframes;  // none: kLiveLocalBaKeyframes when live, else 0 (all)

@@ -133,7 +133,9 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
   report.tracking_ms = milliseconds_since(tracking_start);
   report.tracking_cpu_ms = thread_cpu_ms() - cpu_tracking_start;
 
-  // 6. Map points on dynamic pixels are culled. The culler and the next frame's geometry stage
+  // 6. Map points judged dynamic are culled (--cull-evidence: none by default, the same in
+  // deterministic and live runs; docs/decisions/map-hygiene.md). The culler and the next frame's
+  // geometry stage
   // read points and keyframe poses the back end refines: a deterministic run lets it finish
   // this frame's keyframe first (docs/decisions/back-end-wait.md).
   if (dynamic_) {

@@ -135,9 +135,8 @@ FrameReport TrackingModule::process(const InputFrame& frame) {
 
   // 6. Map points judged dynamic are culled (--cull-evidence: none by default, the same in
   // deterministic and live runs; docs/decisions/map-hygiene.md). The culler and the next frame's
-  // geometry stage
-  // read points and keyframe poses the back end refines: a deterministic run lets it finish
-  // this frame's keyframe first (docs/decisions/back-end-wait.md).
+  // geometry stage read points and keyframe poses the back end refines: a deterministic run lets
+  // it finish this frame's keyframe first (docs/decisions/back-end-wait.md).
   if (dynamic_) {
     back_end_.wait_for_back_end();
     dynamic_->end_frame(report.tracking, depth, semantic_mask, report.dynamic);

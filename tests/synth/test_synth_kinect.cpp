@@ -327,7 +327,7 @@ TEST(SynthKinect, WrittenSequenceHasMarkerGroundTruthDistortionAndIsDeterministi
     EXPECT_EQ(bytes_a, bytes_b) << relative;
     ++files;
   }
-  EXPECT_EQ(files, 4u * 3u + 8u);  // + body_to_camera.txt
+  EXPECT_EQ(files, 4u * 3u + 9u);  // + body_to_camera.txt, people.txt
 }
 
 // depth.txt stamps (and names) each depth image with its own capture instant, as a Kinect driver

@@ -17,6 +17,8 @@ CLI_ONLY = {"--help", "--log-level", "--quiet", "--sequence", "--camera", "--vid
             "--sensor", "--trajectory-format", "--out", "--max-frames", "--start-frame",
             "--preload", "--priority", "--opencv-threads", "--blackout"}
 OUTPUT_FLAG = re.compile(r"^--(export|save|viewer)(-[a-z-]+)?$")
+# The occupancy map is built by the CLI only: Python has no occupancy keywords yet.
+OCCUPANCY_FLAG = re.compile(r"^--(occupancy|grid)(-[a-z-]+)?$")
 
 
 def run_flags(cli):
@@ -44,7 +46,7 @@ def python_settings(sequence, keywords):
 def test_every_run_flag_is_a_keyword_or_only_the_cli_s(cli):
     flags = {option["flag"] for option in pspslam.run_options() if option["flag"]}
     for flag in sorted(run_flags(cli)):
-        if flag in CLI_ONLY or OUTPUT_FLAG.match(flag):
+        if flag in CLI_ONLY or OUTPUT_FLAG.match(flag) or OCCUPANCY_FLAG.match(flag):
             continue
         assert flag in flags, f"{flag}: neither a System keyword nor one of the CLI's own flags"
     # And every keyword's flag is a flag of the program.

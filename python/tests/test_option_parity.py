@@ -89,7 +89,7 @@ def changed_values(small_sequence):
              "due_keyframes": [], "motion_prior": ["2.5", "0.5"],
              "vocabulary": [str(data / "models/vocabulary/orb_k10_l5.pspvoc")],
              "relocalization": [], "new_map_after": ["2.5"], "loop_closing": ["off"],
-             "cull_hits": ["4"]}
+             "cull_hits": ["4"], "cull_evidence": ["mask"]}
     keywords = {"mode": "semantic", "model": words["model"][0], "realtime": True,
                 "local_mapping": False, "background_nice": 4, "segment_every": 2,
                 "semantic_pace": "on", "smaller_model": words["smaller_model"][0],
@@ -100,7 +100,8 @@ def changed_values(small_sequence):
                 "keyframe_ratio": 0.5, "local_ba_keyframes": 3, "local_ba_fixed_keyframes": 2,
                 "ba_tracking_factors": 0.25, "due_keyframes": True, "motion_prior": (2.5, 0.5),
                 "vocabulary": words["vocabulary"][0], "relocalization": False,
-                "new_map_after": 2.5, "loop_closing": "off", "cull_hits": 4}
+                "new_map_after": 2.5, "loop_closing": "off", "cull_hits": 4,
+                "cull_evidence": "mask"}
     return words, keywords
 
 

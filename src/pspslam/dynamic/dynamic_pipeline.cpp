@@ -253,14 +253,8 @@ void DynamicPipeline::end_frame(const TrackResult& result, const cv::Mat& depth,
     }
     last_pose_ = result.T_world_camera;
     last_pose_id_ = current_id_;
-    if (options_.culling.evidence == CullingEvidence::none) {
-      // Nothing to judge: no mask is fused for culling.
-    } else if (culls_by_sight()) {
-      if (!protect_map_) report.culled_map_points += cull(*result.T_world_camera, {}, depth);
-    } else if (const cv::Mat cull_mask = culling_mask(report);
-               !cull_mask.empty() && !protect_map_) {
-      report.culled_map_points += cull(*result.T_world_camera, cull_mask, depth);
-    }
+    if (!protect_map_)
+      report.culled_map_points += cull_frame(*result.T_world_camera, depth, report);
   }
 }
 
@@ -277,10 +271,20 @@ int DynamicPipeline::cull(const Pose& T_world_camera, const cv::Mat& mask, const
   return static_cast<int>(culled.size());
 }
 
-// Culling by what the frame's depth sees, whatever the masks (CullingEvidence::seen_through).
-bool DynamicPipeline::culls_by_sight() const {
-  return options_.mode != DynamicMode::off &&
-         options_.culling.evidence == CullingEvidence::seen_through;
+// Step 6 for this frame, by the run's culling evidence: what its depth sees through, or its
+// culling mask; nothing when culling is off (no mask is fused for it then).
+int DynamicPipeline::cull_frame(const Pose& T_world_camera, const cv::Mat& depth,
+                                const DynamicReport& report) {
+  switch (options_.culling.evidence) {
+    case CullingEvidence::none:
+      return 0;
+    case CullingEvidence::seen_through:
+      return cull(T_world_camera, {}, depth);
+    case CullingEvidence::dynamic_pixels:
+      break;
+  }
+  const cv::Mat mask = culling_mask(report);
+  return mask.empty() ? 0 : cull(T_world_camera, mask, depth);
 }
 
 // A live run culling on exact masks only, whose mask for this frame is stale: only late masks,

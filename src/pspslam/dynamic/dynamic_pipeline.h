@@ -224,7 +224,7 @@ class DynamicPipeline {
                                 const DynamicReport& report);
   bool judged_by_late_masks_only(const DynamicReport& report) const;
   cv::Mat culling_mask(const DynamicReport& report) const;
-  bool culls_by_sight() const;
+  int cull_frame(const Pose& T_world_camera, const cv::Mat& depth, const DynamicReport& report);
   int cull(const Pose& T_world_camera, const cv::Mat& mask, const cv::Mat& depth);
   void collect_reference_views();
   std::optional<Pose> prior_pose() const;

@@ -93,6 +93,10 @@ def parse_arguments(argv):
     every.add_argument("--allow-dirty", action="store_true",
                        help="run on a checkout with changes or a build of another commit (the "
                             "sections then say so in their commit)")
+    every.add_argument("--skip", default="", metavar="NAMES",
+                       help="comma-separated experiments to leave out (their sections keep the "
+                            "figures they have, with their own commit): for one too long for "
+                            "this sitting, e.g. patrol")
     for command in (run, every):
         add_common_arguments(command)
     return parser, parser.parse_args(argv)
@@ -431,13 +435,14 @@ def run_experiment(parser, args, experiment, setup):
     return failures
 
 
-def current_experiments():
+def current_experiments(skip=()):
     """Every experiment `all` regenerates, the timing (exclusive) ones last: no download, no
-    decision record."""
+    decision record, not named in `skip`."""
     chosen = []
     for path in sorted((REPO / "bench" / "experiments").glob("*.toml")):
         experiment = experiments.load(path)
-        if not experiment.needs_download() and experiment.record is None:
+        if (not experiment.needs_download() and experiment.record is None
+                and experiment.name not in skip):
             chosen.append(experiment)
     return sorted(chosen, key=lambda e: e.exclusive)
 
@@ -459,7 +464,15 @@ def require_clean_commit(parser, setup):
 def run_all(parser, args, setup):
     if not args.allow_dirty:
         require_clean_commit(parser, setup)
-    chosen = current_experiments()
+    skip = [name for name in args.skip.split(",") if name]
+    known = [e.name for e in current_experiments()]
+    for name in skip:
+        if name not in known:
+            parser.error(f"--skip: '{name}' is not one of the experiments `all` runs "
+                         f"({', '.join(known)})")
+    chosen = current_experiments(skip)
+    if skip:
+        log("all: leaving out " + ", ".join(skip) + " (their sections keep their own commit)")
     log("all: " + ", ".join(e.name + (" (alone)" if e.exclusive else "") for e in chosen))
     failed = []
     for experiment in chosen:

@@ -3,6 +3,8 @@ evidence lives in its record. Every command a section gives runs from the reposi
 import re
 import sys
 
+import pytest
+
 from conftest import REPO
 
 sys.path.insert(0, str(REPO / "bench"))
@@ -25,6 +27,16 @@ def test_all_runs_every_current_experiment_without_a_download_timing_last():
     assert "live_late_masks" not in names  # a decision's evidence
     exclusive = [e.exclusive for e in chosen]
     assert exclusive == sorted(exclusive)  # the timing ones after the others
+    assert [e.name for e in runner.current_experiments(["patrol"])] == [
+        name for name in names if name != "patrol"]
+
+
+def test_all_refuses_to_skip_an_experiment_it_does_not_run(capsys):
+    with pytest.raises(SystemExit) as stop:
+        runner.main(["all", "--skip", "tum_dynamic", "--allow-dirty", "--dry-run"])
+    assert stop.value.code == 2
+    assert "--skip: 'tum_dynamic' is not one of the experiments `all` runs" in (
+        capsys.readouterr().err)
 
 
 def test_each_experiment_s_section_is_in_its_one_place():

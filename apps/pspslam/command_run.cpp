@@ -8,8 +8,9 @@
 //                    interrupted run leaves a valid file
 //   lost_frames.txt  timestamps of frames that got no pose (not initialised yet or lost)
 //   keyframes.txt    keyframe poses at the end (after local mapping)
-//   trajectory_refined.txt  the final trajectory, written at the end: the frames of
-//                    trajectory.txt moved with the BA-refined keyframes around them in time
+//   trajectory_refined.txt  the final trajectory and the file to evaluate, written at the end
+//                    (also on Ctrl-C): the frames of trajectory.txt moved with the BA-refined
+//                    keyframes around them in time
 //   timing.csv       per frame: extraction / tracking / local BA milliseconds, state, and the
 //                    dynamic-scene stages (mask age, geometry time, masked keypoints), the
 //                    map's keyframes and points, resident memory
@@ -427,8 +428,9 @@ Command add_run_command(CLI::App& root) {
       "run",
       "run SLAM on an RGB-D sequence and write the trajectory.\n"
       "Reads a sequence in TUM layout (rgb.txt, depth.txt or associations.txt, optional "
-      "groundtruth.txt)\nand writes OUT/trajectory.txt (every tracked frame), "
-      "OUT/trajectory_refined.txt, OUT/lost_frames.txt,\nOUT/keyframes.txt, OUT/timing.csv, "
+      "groundtruth.txt)\nand writes OUT/trajectory_refined.txt (the file to evaluate), "
+      "OUT/trajectory.txt (every frame as tracked),\nOUT/lost_frames.txt, OUT/keyframes.txt, "
+      "OUT/timing.csv, "
       "OUT/stats.json and OUT/run_config.yaml (the config used). With ground truth, prints ATE.");
   auto flags = std::make_shared<RunFlags>();
   CLI::Option* sequence = add_input_options(app, flags);

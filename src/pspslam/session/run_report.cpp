@@ -562,9 +562,10 @@ void write_run_report(const RunReportInput& input, std::ostream& out) {
   if (monocular) print_monocular_start(input.statistics, map_loaded, out);
   print_longest_lost_stretch(input.statistics, out);
   print_atlas(input.atlas, out);
-  out << "output:       " << (out_dir / "trajectory.txt").string() << " (" << input.estimate.size()
-      << " poses), trajectory_refined.txt, keyframes.txt, lost_frames.txt, timing.csv,\n"
-      << "              run_config.yaml (the config used)\n";
+  out << "output:       " << (out_dir / "trajectory_refined.txt").string()
+      << " (the file to evaluate, " << input.refined.size()
+      << " poses), trajectory.txt (as tracked), keyframes.txt,\n"
+      << "              lost_frames.txt, timing.csv, run_config.yaml (the config used)\n";
   ReportedSections reported;
   reported.ate = report_ate(input, monocular, out);
   if (input.options.blackout)

@@ -163,7 +163,7 @@ RunOptions run_options(const RunFlags& flags, const GlobalOptions& global) {
   options.outputs.export_dense = flags.export_dense;
   options.outputs.masks = flags.save_masks;
   options.outputs.overlays = flags.save_overlays;
-  options.occupancy = occupancy_options(flags.occupancy);
+  options.occupancy = occupancy_options(flags.occupancy, flags.settings);
   // Every output path is checked (and its folder created) before any work.
   prepare_run_outputs(options.outputs);
   prepare_occupancy_outputs(options.occupancy);

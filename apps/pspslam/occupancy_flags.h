@@ -9,15 +9,11 @@
 
 namespace pspslam::cli {
 
-// `pspslam run`'s occupancy map flags (session/occupancy_run.h).
+// `pspslam run`'s own occupancy flags (session/occupancy_run.h): the outputs, the grid's band and
+// the scoring. The map's options (--occupancy, --occupancy-*) are in the run option table.
 struct OccupancyFlags {
-  bool occupancy = false;
   std::string export_octomap;
   std::string export_grid;
-  double resolution = OccupancyOptions{}.resolution_m;
-  double max_range = OccupancyOptions{}.max_range_m;
-  std::string masks = "on";
-  std::string clearing = "on";
   double min_height = GridOptions{}.min_height_m;
   double max_height = GridOptions{}.max_height_m;
   std::string floor = "auto";
@@ -25,10 +21,6 @@ struct OccupancyFlags {
 };
 
 inline void add_occupancy_options(CLI::App* app, OccupancyFlags& flags) {
-  app->add_flag("--occupancy", flags.occupancy,
-                "build an occupancy map of the static scene while the run goes (keyframes' depth "
-                "without the dynamic pixels, ray cast into an OctoMap on its own thread); its "
-                "memory, cost and counts go to stats.json");
   app->add_option("--export-octomap", flags.export_octomap,
                   "write the occupancy map at the final keyframe poses as an OctoMap binary "
                   "(.bt, octovis reads it); implies --occupancy");
@@ -36,19 +28,6 @@ inline void add_occupancy_options(CLI::App* app, OccupancyFlags& flags) {
                   "write a 2D occupancy grid in ROS map_server format to this YAML file and the "
                   "PGM beside it: the map over the height band above the floor; implies "
                   "--occupancy");
-  app->add_option("--occupancy-resolution", flags.resolution, "occupancy voxel edge in metres")
-      ->capture_default_str();
-  app->add_option("--occupancy-max-range", flags.max_range,
-                  "depth readings farther than this (metres) mark free space only")
-      ->capture_default_str();
-  app->add_option("--occupancy-masks", flags.masks,
-                  "leave each keyframe's dynamic pixels out of the occupancy map")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  app->add_option("--occupancy-clearing", flags.clearing,
-                  "rays free the voxels they pass through (off: only hits count, as a point cloud)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
   app->add_option("--grid-min-height", flags.min_height,
                   "lowest height above the floor the 2D grid sees (metres)")
       ->capture_default_str();
@@ -65,18 +44,16 @@ inline void add_occupancy_options(CLI::App* app, OccupancyFlags& flags) {
                   "stats.json; implies --occupancy");
 }
 
-// The occupancy options the flags ask for; throws pspslam::Error naming a bad flag.
-inline OccupancyRunOptions occupancy_options(const OccupancyFlags& flags) {
-  OccupancyRunOptions options;
-  options.enabled = flags.occupancy || !flags.export_octomap.empty() ||
+// The occupancy options the flags and the table's settings ask for; throws pspslam::Error naming
+// a bad flag.
+inline OccupancyRunOptions occupancy_options(const OccupancyFlags& flags,
+                                             const RunSettings& settings) {
+  OccupancyRunOptions options = occupancy_run_options(settings);
+  options.enabled = options.enabled || !flags.export_octomap.empty() ||
                     !flags.export_grid.empty() || !flags.truth.empty();
   options.export_octomap = flags.export_octomap;
   options.export_grid = flags.export_grid;
   options.truth = flags.truth;
-  options.map.resolution_m = flags.resolution;
-  options.map.max_range_m = flags.max_range;
-  options.map.use_masks = flags.masks == "on";
-  options.map.clearing = flags.clearing == "on";
   options.grid.min_height_m = flags.min_height;
   options.grid.max_height_m = flags.max_height;
   if (flags.floor != "auto") {

@@ -149,6 +149,26 @@ std::pair<SystemConfig, std::string> config_from(const py::handle& config) {
   return {load_config(file), file.string()};
 }
 
+// The 2D grid's band as `pspslam run --grid-min-height --grid-max-height --grid-floor` takes it,
+// checked by the same GridOptions::validate(), its message naming the keywords.
+GridOptions grid_band(double min_height, double max_height, const std::optional<double>& floor) {
+  GridOptions band{.min_height_m = min_height, .max_height_m = max_height, .floor_height_m = floor};
+  try {
+    band.validate();
+  } catch (const Error& e) {
+    std::string message = e.what();
+    for (const auto& [flag, keyword] :
+         {std::pair{"flags ", ""}, std::pair{"flag ", ""},
+          std::pair{"--grid-min-height", "min_height"},
+          std::pair{"--grid-max-height", "max_height"}, std::pair{"--grid-floor", "floor"}}) {
+      for (size_t at = message.find(flag); at != std::string::npos; at = message.find(flag))
+        message.replace(at, std::string(flag).size(), keyword);
+    }
+    throw py::value_error(message);
+  }
+  return band;
+}
+
 std::unique_ptr<PySystem> make_system(const py::handle& config, const std::string& mode,
                                       const std::optional<std::string>& sensor, bool keypoints,
                                       const py::kwargs& options) {
@@ -300,6 +320,18 @@ void register_system(py::module_& m) {
       .def("map_points", &PySystem::map_points)
       .def("keyframe_poses", &PySystem::keyframe_trajectory)
       .def("save_map", &PySystem::save_map, py::arg("path"))
+      .def(
+          "occupancy_grid",
+          [](PySystem& s, double min_height, double max_height,
+             const std::optional<double>& floor) {
+            return s.occupancy_grid(grid_band(min_height, max_height, floor));
+          },
+          py::kw_only(), py::arg("min_height") = GridOptions{}.min_height_m,
+          py::arg("max_height") = GridOptions{}.max_height_m, py::arg("floor") = py::none(),
+          "the occupancy map's 2D grid over the band min_height..max_height metres above the "
+          "floor (floor: its height, None: found in the map), as `pspslam run --export-grid` "
+          "writes it: grid (int8 rows x cols, row 0 at the origin's y; -1 unknown, 0 free, 100 "
+          "occupied), resolution, origin (x, y), T_world_grid (4x4) and floor_height")
       .def_property_readonly("mode", &PySystem::dynamic_mode)
       .def_property_readonly(
           "settings",

@@ -1,7 +1,10 @@
 #include "python_system.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -78,6 +81,9 @@ PySystem::PySystem(SystemConfig config, std::string config_name, const RunSettin
   options_.record_keypoint_fates = keypoints;
   py::gil_scoped_release release;  // loading the model and the vocabulary takes a while
   system_ = std::make_unique<System>(config_, options_);
+  if (settings.occupancy)
+    occupancy_ =
+        std::make_unique<OccupancyRun>(config_.camera.pinhole, occupancy_run_options(settings));
 }
 
 PySystem::~PySystem() = default;
@@ -163,6 +169,9 @@ PyResult PySystem::track(const PyFrame& frame) {
     py::gil_scoped_release release;
     result.report = system_->process(*frame.frame);
     result.mask = system_->last_dynamic_mask();
+    if (occupancy_ && result.report.tracking.keyframe_inserted)
+      occupancy_->add_keyframe(system_->map().keyframe(system_->map().max_keyframe_id()),
+                               frame.frame->depth, result.mask);
   }
   if (result.mask.empty()) result.mask = cv::Mat::zeros(frame.frame->bgr.size(), CV_8UC1);
   return result;
@@ -174,6 +183,37 @@ void PySystem::shutdown() {
   shut_down_ = true;
   py::gil_scoped_release release;
   system_->shutdown();
+  // As `pspslam run` ends: every keyframe enters the map, rebuilt at its final pose. Its exports
+  // are the CLI's, so what finish() reports is not wanted here.
+  std::ostringstream unused;
+  if (occupancy_) occupancy_->finish(system_->keyframe_trajectory(), unused);
+}
+
+py::dict PySystem::occupancy_grid(const GridOptions& band) {
+  auto lock = claim("occupancy_grid");
+  if (!occupancy_)
+    throw py::value_error(
+        "occupancy_grid: this System builds no occupancy map (make it with occupancy=True)");
+  OccupancyGrid grid;
+  {
+    py::gil_scoped_release release;
+    grid = occupancy_->grid(band);
+  }
+  // Row 0 holds the cells nearest the origin (lowest y), as a ROS OccupancyGrid message.
+  py::array_t<std::int8_t> cells(
+      {static_cast<py::ssize_t>(grid.height), static_cast<py::ssize_t>(grid.width)});
+  std::copy(grid.cells.begin(), grid.cells.end(), cells.mutable_data());
+  py::array_t<double> pose({py::ssize_t{4}, py::ssize_t{4}});
+  auto entries = pose.mutable_unchecked<2>();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) entries(r, c) = grid.T_world_grid.matrix()(r, c);
+  py::dict result;
+  result["grid"] = cells;
+  result["resolution"] = grid.resolution;
+  result["origin"] = py::make_tuple(grid.origin.x(), grid.origin.y());
+  result["T_world_grid"] = pose;
+  result["floor_height"] = grid.floor.height;
+  return result;
 }
 
 py::array PySystem::map_points() {

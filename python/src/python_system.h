@@ -14,6 +14,7 @@
 
 #include "pspslam/config/config.h"
 #include "pspslam/io/input_frame.h"
+#include "pspslam/session/occupancy_run.h"
 #include "pspslam/system/system.h"
 #include "system_options.h"
 
@@ -55,6 +56,9 @@ class PySystem {
   py::array map_points();
   py::tuple keyframe_trajectory() const;
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
+  // The occupancy map's 2D grid over this band (occupancy=True only; ValueError otherwise): the
+  // live map while the System runs, the map rebuilt at the final poses once it has shut down.
+  py::dict occupancy_grid(const GridOptions& band);
 
   const SystemConfig& config() const { return config_; }
   const SystemOptions& options() const { return options_; }
@@ -73,6 +77,7 @@ class PySystem {
   SystemOptions options_;
   std::vector<std::pair<std::string, std::string>> settings_;
   std::unique_ptr<System> system_;
+  std::unique_ptr<OccupancyRun> occupancy_;  // with occupancy=True, fed as `pspslam run` feeds it
   std::mutex busy_;
   bool shut_down_ = false;
   std::optional<Timestamp> last_timestamp_;  // of the last frame tracked or announced

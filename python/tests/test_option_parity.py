@@ -17,8 +17,10 @@ CLI_ONLY = {"--help", "--log-level", "--quiet", "--sequence", "--camera", "--vid
             "--sensor", "--trajectory-format", "--out", "--max-frames", "--start-frame",
             "--preload", "--priority", "--opencv-threads", "--blackout"}
 OUTPUT_FLAG = re.compile(r"^--(export|save|viewer)(-[a-z-]+)?$")
-# The occupancy map is built by the CLI only: Python has no occupancy keywords yet.
-OCCUPANCY_FLAG = re.compile(r"^--(occupancy|grid)(-[a-z-]+)?$")
+# The occupancy map's own options (--occupancy, --occupancy-resolution, ...) are keywords like any
+# other; its scoring against a synthetic truth is the CLI's, and the 2D grid's band
+# (--grid-min-height, --grid-max-height, --grid-floor) is System.occupancy_grid()'s arguments.
+CLI_ONLY |= {"--occupancy-truth", "--grid-min-height", "--grid-max-height", "--grid-floor"}
 
 
 def run_flags(cli):
@@ -46,7 +48,7 @@ def python_settings(sequence, keywords):
 def test_every_run_flag_is_a_keyword_or_only_the_cli_s(cli):
     flags = {option["flag"] for option in pspslam.run_options() if option["flag"]}
     for flag in sorted(run_flags(cli)):
-        if flag in CLI_ONLY or OUTPUT_FLAG.match(flag) or OCCUPANCY_FLAG.match(flag):
+        if flag in CLI_ONLY or OUTPUT_FLAG.match(flag):
             continue
         assert flag in flags, f"{flag}: neither a System keyword nor one of the CLI's own flags"
     # And every keyword's flag is a flag of the program.
@@ -89,7 +91,9 @@ def changed_values(small_sequence):
              "due_keyframes": [], "motion_prior": ["2.5", "0.5"],
              "vocabulary": [str(data / "models/vocabulary/orb_k10_l5.pspvoc")],
              "relocalization": [], "new_map_after": ["2.5"], "loop_closing": ["off"],
-             "cull_hits": ["4"], "cull_evidence": ["mask"]}
+             "cull_hits": ["4"], "cull_evidence": ["mask"], "occupancy": [],
+             "occupancy_resolution": ["0.1"], "occupancy_max_range": ["3"],
+             "occupancy_masks": ["off"], "occupancy_clearing": ["off"]}
     keywords = {"mode": "semantic", "model": words["model"][0], "realtime": True,
                 "local_mapping": False, "background_nice": 4, "segment_every": 2,
                 "semantic_pace": "on", "smaller_model": words["smaller_model"][0],
@@ -101,7 +105,8 @@ def changed_values(small_sequence):
                 "ba_tracking_factors": 0.25, "due_keyframes": True, "motion_prior": (2.5, 0.5),
                 "vocabulary": words["vocabulary"][0], "relocalization": False,
                 "new_map_after": 2.5, "loop_closing": "off", "cull_hits": 4,
-                "cull_evidence": "mask"}
+                "cull_evidence": "mask", "occupancy": True, "occupancy_resolution": 0.1,
+                "occupancy_max_range": 3.0, "occupancy_masks": "off", "occupancy_clearing": "off"}
     return words, keywords
 
 
@@ -166,3 +171,12 @@ def test_options_that_go_together_are_told_alike(cli, small_sequence, tmp_path):
     with pytest.raises(ValueError, match=r"^localization: needs load_map \(a map to localise "
                                          r"in\)$"):
         pspslam.System(pspslam.read_sequence(small_sequence), localization=True)
+    run = subprocess.run([cli, "run", "--sequence", str(small_sequence), "--out",
+                          str(tmp_path / "out2"), "--occupancy-resolution", "0.5",
+                          "--occupancy-max-range", "0.4"], capture_output=True, text=True)
+    assert run.returncode == 2
+    assert "--occupancy-max-range: must exceed --occupancy-resolution" in run.stderr
+    with pytest.raises(ValueError, match=r"^occupancy_max_range: must exceed "
+                                         r"occupancy_resolution$"):
+        pspslam.System(pspslam.read_sequence(small_sequence), occupancy_resolution=0.5,
+                       occupancy_max_range=0.4)

@@ -8,6 +8,7 @@
 #include "pspslam/core/error.h"
 #include "pspslam/io/trajectory_io.h"
 #include "pspslam/session/frame_log.h"
+#include "pspslam/session/occupancy_run.h"
 #include "pspslam/session/run_option_table.h"
 #include "pspslam/session/run_options.h"
 #include "pspslam/session/run_settings.h"
@@ -243,6 +244,28 @@ TEST(RunSettings, ALiveSourceWaitsForLocalMappingOnlyAndEveryRunGetsTheLiveMaskP
   const SystemOptions changed = system_options(settings);
   EXPECT_FALSE(changed.dynamic.cull_with_late_masks);
   EXPECT_EQ(changed.dynamic.semantic.injected_delay, (SemanticDelay{10, 20, 7}));
+}
+
+// The occupancy map's options come from the table, so `pspslam run` and Python build one map.
+TEST(RunOptionTable, OccupancyOptionsReachTheMap) {
+  EXPECT_FALSE(occupancy_run_options(RunSettings{}).enabled);
+  RunSettings settings;
+  for (const auto& [keyword, words] : {std::pair<std::string, std::string>{"occupancy", ""},
+                                       {"occupancy_resolution", "0.1"},
+                                       {"occupancy_max_range", "3"},
+                                       {"occupancy_masks", "off"},
+                                       {"occupancy_clearing", "off"}}) {
+    const RunOption& option = *find_run_option_by_keyword(keyword);
+    option.set(settings, parse_run_text(option, {words}));
+  }
+  const OccupancyRunOptions options = occupancy_run_options(settings);
+  EXPECT_TRUE(options.enabled);
+  EXPECT_DOUBLE_EQ(options.map.resolution_m, 0.1);
+  EXPECT_DOUBLE_EQ(options.map.max_range_m, 3.0);
+  EXPECT_FALSE(options.map.use_masks);
+  EXPECT_FALSE(options.map.clearing);
+  settings.occupancy_max_range = 0.05;
+  EXPECT_THROW(check_run_settings(settings, SettingNames{}), Error);
 }
 
 TEST(RunOptionTable, FlagsAndKeywordsAreUniqueAndBadValuesAreToldOnce) {

@@ -67,6 +67,16 @@ void OccupancyRunOptions::validate() const {
                 " holds no static.txt (pspslam synth --occupancy-truth RES writes it)");
 }
 
+OccupancyRunOptions occupancy_run_options(const RunSettings& settings) {
+  OccupancyRunOptions options;
+  options.enabled = settings.occupancy;
+  options.map.resolution_m = settings.occupancy_resolution;
+  options.map.max_range_m = settings.occupancy_max_range;
+  options.map.use_masks = settings.occupancy_masks == "on";
+  options.map.clearing = settings.occupancy_clearing == "on";
+  return options;
+}
+
 OccupancyRun::OccupancyRun(const PinholeCamera& camera, OccupancyRunOptions options)
     : options_(std::move(options)), mapper_(camera, options_.map) {}
 
@@ -75,19 +85,26 @@ void OccupancyRun::add_keyframe(std::shared_ptr<const KeyFrame> keyframe, const 
   mapper_.add_keyframe(std::move(keyframe), depth, dynamic_mask);
 }
 
-void OccupancyRun::finish(const Trajectory& keyframes, std::ostream& out) {
-  mapper_.finish();
-  const OccupancyStats stats = mapper_.stats();
+OccupancyGrid OccupancyRun::grid(const GridOptions& band) const {
   OccupancyGrid grid;
   const std::vector<Eigen::Vector3d> cameras = mapper_.camera_centres();
   mapper_.read([&](const OccupancyMap& map) {
-    if (!options_.export_octomap.empty()) {
+    grid = make_grid(map, find_floor(map, cameras, band), band);
+  });
+  return grid;
+}
+
+void OccupancyRun::finish(const Trajectory& keyframes, std::ostream& out) {
+  mapper_.finish();
+  const OccupancyStats stats = mapper_.stats();
+  if (!options_.export_octomap.empty()) {
+    mapper_.read([&](const OccupancyMap& map) {
       map.write_binary(options_.export_octomap);
       out << "occupancy:    " << options_.export_octomap.string() << " (OctoMap, "
           << map.resolution() << " m voxels)\n";
-    }
-    grid = make_grid(map, find_floor(map, cameras, options_.grid), options_.grid);
-  });
+    });
+  }
+  const OccupancyGrid grid = this->grid(options_.grid);
   const size_t seen_through =
       occupied_cells_seen_through(grid, options_.grid, mapper_.seen_through());
   if (!options_.export_grid.empty()) {

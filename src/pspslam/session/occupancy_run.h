@@ -8,8 +8,10 @@
 
 #include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/core/types.h"
+#include "pspslam/occupancy/occupancy_grid.h"
 #include "pspslam/occupancy/occupancy_mapper.h"
 #include "pspslam/occupancy/occupancy_options.h"
+#include "pspslam/session/run_settings.h"
 
 namespace pspslam {
 
@@ -30,6 +32,10 @@ struct OccupancyRunOptions {
   void validate() const;
 };
 
+// What the run settings ask of the map (--occupancy and the --occupancy-* options, shared with
+// Python's keywords); the outputs and the grid's band are left at their defaults.
+OccupancyRunOptions occupancy_run_options(const RunSettings& settings);
+
 // The occupancy map of one run: built while it goes (OccupancyMapper), then rebuilt at the final
 // poses, exported, counted (occupied grid cells later keyframes saw through) and scored.
 class OccupancyRun {
@@ -44,6 +50,8 @@ class OccupancyRun {
   void finish(const Trajectory& keyframes, std::ostream& out);
   // stats.json's "occupancy" member (after finish()).
   const nlohmann::ordered_json& json() const { return json_; }
+  // The 2D grid over this band of the map as it stands (the final map after finish()).
+  OccupancyGrid grid(const GridOptions& band) const;
   const OccupancyMapper& mapper() const { return mapper_; }
 
  private:

@@ -367,6 +367,29 @@ void add_map_options(std::vector<RunOption>& table) {
       {"off", "mask", "seen-through"}));
 }
 
+// The occupancy map of the static scene; its outputs (--export-octomap, --export-grid) and its
+// scoring are the CLI's own, the 2D grid's band is an argument of Python's occupancy_grid().
+void add_occupancy_options(std::vector<RunOption>& table) {
+  table.push_back(flag_option<&RunSettings::occupancy>(
+      "--occupancy", "occupancy",
+      "build an occupancy map of the static scene while the run goes (keyframes' depth without "
+      "the dynamic pixels, ray cast into an OctoMap on its own thread); its memory, cost and "
+      "counts go to stats.json",
+      false));
+  table.push_back(number_option<&RunSettings::occupancy_resolution>(
+      "--occupancy-resolution", "occupancy_resolution", "occupancy voxel edge in metres",
+      Kind::real, 0.005, 2.0));
+  table.push_back(number_option<&RunSettings::occupancy_max_range>(
+      "--occupancy-max-range", "occupancy_max_range",
+      "depth readings farther than this (metres) mark free space only", Kind::real, 0.1, 100.0));
+  table.push_back(choice_option<&RunSettings::occupancy_masks>(
+      "--occupancy-masks", "occupancy_masks",
+      "leave each keyframe's dynamic pixels out of the occupancy map", kOnOff));
+  table.push_back(choice_option<&RunSettings::occupancy_clearing>(
+      "--occupancy-clearing", "occupancy_clearing",
+      "rays free the voxels they pass through (off: only hits count, as a point cloud)", kOnOff));
+}
+
 std::vector<RunOption> make_table() {
   std::vector<RunOption> table;
   add_dynamic_options(table);
@@ -374,6 +397,7 @@ std::vector<RunOption> make_table() {
   add_mask_source_options(table);
   add_keyframe_options(table);
   add_map_options(table);
+  add_occupancy_options(table);
   return table;
 }
 
@@ -509,6 +533,8 @@ void check_run_settings(const RunSettings& settings, const SettingNames& names) 
   if (settings.semantic_delay_seed != RunSettings{}.semantic_delay_seed &&
       settings.semantic_delay_ms.empty())
     throw Error(name("semantic_delay_seed") + ": needs " + name("semantic_delay_ms"));
+  if (!(settings.occupancy_max_range > settings.occupancy_resolution))
+    throw Error(name("occupancy_max_range") + ": must exceed " + name("occupancy_resolution"));
 }
 
 std::vector<std::pair<std::string, std::string>> effective_settings(const RunSettings& settings,

@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "pspslam/occupancy/occupancy_options.h"
 #include "pspslam/system/system.h"
 
 namespace pspslam {
@@ -71,6 +72,12 @@ struct RunSettings {
   std::string mover_guard = "off";         // on | off
   std::string semantic_delay_ms;           // fault injection: MS | random:MIN:MAX; empty: none
   long long semantic_delay_seed = 1;
+  // The occupancy map of the static scene, built beside the run (session/occupancy_run.h).
+  bool occupancy = false;
+  double occupancy_resolution = OccupancyOptions{}.resolution_m;
+  double occupancy_max_range = OccupancyOptions{}.max_range_m;
+  std::string occupancy_masks = "on";     // on | off
+  std::string occupancy_clearing = "on";  // on | off
 
   // A live run must keep up with its frames, so its background work yields and its BA is capped.
   bool live() const { return realtime || live_camera; }

@@ -3,9 +3,9 @@
 
     examples/track_sequence.py SEQUENCE_DIR OUT_TRAJECTORY.txt [--config CONFIG] [--mode MODE]
 
-Reads a TUM/Bonn, KITTI or EuRoC folder, tracks every frame, writes the camera-to-world poses as
-a TUM trajectory (the same bytes `pspslam run` writes to trajectory.txt), prints the ATE when the
-folder has ground truth, and saves OUT_TRAJECTORY.png: the trajectory seen from above and the
+Reads a TUM/Bonn, KITTI or EuRoC folder, tracks every frame, writes the final camera-to-world
+poses as a TUM trajectory (the same bytes `pspslam run` writes to trajectory_refined.txt, the file
+to evaluate), prints the ATE when the folder has ground truth, and saves OUT_TRAJECTORY.png: the trajectory seen from above and the
 frame with the most dynamic pixels, its dynamic mask in red.
 """
 
@@ -23,19 +23,17 @@ import pspslam  # noqa: E402
 
 
 def track(sequence, mode):
-    """Poses of the tracked frames, and (image, mask) of the frame with the most dynamic pixels."""
-    timestamps, poses = [], []
+    """The final trajectory, and (image, mask) of the frame with the most dynamic pixels."""
     busiest, most_dynamic = None, -1
     with pspslam.System(sequence, mode=mode) as slam:
         for frame, result in slam.track_frames(sequence):
-            if result.pose is not None:
-                timestamps.append(frame.timestamp)
-                poses.append(result.pose)
+            # result.pose is the frame as tracked now (trajectory.txt); refined_poses() below
+            # moves every frame with the bundle-adjusted keyframes once the run is over.
             dynamic = np.count_nonzero(result.mask)
             if dynamic > most_dynamic:
                 # Views, not copies: they keep the frame's pixels and the mask alive.
                 busiest, most_dynamic = (frame.image, result.mask), dynamic
-    return (np.array(timestamps), np.array(poses).reshape(-1, 4, 4)), busiest
+    return slam.refined_poses(), busiest
 
 
 def plot(path, trajectory, ground_truth, ate, busiest):

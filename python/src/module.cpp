@@ -319,6 +319,10 @@ void register_system(py::module_& m) {
       .def("shutdown", &PySystem::shutdown)
       .def("map_points", &PySystem::map_points)
       .def("keyframe_poses", &PySystem::keyframe_trajectory)
+      .def("refined_poses", &PySystem::refined_trajectory,
+           "The final trajectory (pspslam run's trajectory_refined.txt, the file to evaluate): "
+           "(timestamps, Nx4x4 camera-to-world poses) of every tracked frame moved with the "
+           "bundle-adjusted keyframes around it. Finishes the run first, as close() does.")
       .def("save_map", &PySystem::save_map, py::arg("path"))
       .def(
           "occupancy_grid",

@@ -236,6 +236,12 @@ py::tuple PySystem::keyframe_trajectory() const {
   return trajectory_arrays(system_->keyframe_trajectory());
 }
 
+py::tuple PySystem::refined_trajectory() {
+  shutdown();
+  auto lock = claim("refined_poses");
+  return trajectory_arrays(system_->refined_trajectory());
+}
+
 std::pair<size_t, size_t> PySystem::save_map(const std::filesystem::path& file) {
   shutdown();
   auto lock = claim("save_map");

@@ -55,6 +55,9 @@ class PySystem {
 
   py::array map_points();
   py::tuple keyframe_trajectory() const;
+  // The final trajectory (System::refined_trajectory): it needs the back end finished, so this
+  // shuts the system down first.
+  py::tuple refined_trajectory();
   std::pair<size_t, size_t> save_map(const std::filesystem::path& file);
   // The occupancy map's 2D grid over this band (occupancy=True only; ValueError otherwise): the
   // live map while the System runs, the map rebuilt at the final poses once it has shut down.

@@ -22,6 +22,9 @@ def test_trajectory_and_people_are_those_of_the_cli(synthetic_sequence, cli_run,
     expected = (cli_run / "trajectory.txt").read_bytes()
     assert len(timestamps) > 50
     assert ours.read_bytes() == expected
+    refined = tmp_path / "trajectory_refined.txt"
+    pspslam.write_trajectory(refined, slam.refined_poses())
+    assert refined.read_bytes() == (cli_run / "trajectory_refined.txt").read_bytes()
     # people.csv: frame,timestamp,id,x,y,z,vx,vy,vz,extent,visible_pixels
     rows = [line.split(",") for line in (cli_run / "people.csv").read_text().splitlines()[1:]]
     assert len(people) == len(rows) > 0

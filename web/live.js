@@ -10,6 +10,9 @@ const FATE_COLOURS = ['#00d200', '#ffd700', '#a03cff', '#00ffff'];
 // single-map colour, the others stay clear of the other layers' colours.
 const MAP_COLOURS = [0x8ab4ff, 0xd67cff, 0xf2e35c, 0xff8fc4, 0x7be3c3, 0xb0b0ff];
 const mapColour = (id) => MAP_COLOURS[id % MAP_COLOURS.length];
+// People by track id: hues a golden angle apart, so neighbouring ids differ clearly.
+const personHue = (id) => (id * 137.508) % 360;
+const personCss = (id) => `hsl(${personHue(id)}, 85%, 62%)`;
 const $ = (id) => document.getElementById(id);
 const body = document.body;
 
@@ -67,6 +70,7 @@ function drawMarks(frame) {
       }
     }
   }
+  drawPeopleIds(g, frame, s);
   if ($('show-keypoints').checked) {
     g.lineWidth = 1.5;
     for (const [x, y, fate] of frame.keypoints) {
@@ -81,6 +85,30 @@ function drawMarks(frame) {
       g.stroke();
     }
   }
+}
+
+// Each person's id at the pixel her centre projects to (the server projects with the frame's
+// pose and intrinsics); the count drawn is mirrored for the test.
+function drawPeopleIds(g, frame, s) {
+  let drawn = 0;
+  if ($('show-people').checked) {
+    g.font = 'bold 13px sans-serif';
+    g.textAlign = 'center';
+    g.textBaseline = 'middle';
+    for (const person of frame.people) {
+      if (!person.pixel) continue;
+      const [x, y] = [person.pixel[0] * s, person.pixel[1] * s];
+      if (x < 0 || y < 0 || x > g.canvas.width || y > g.canvas.height) continue;
+      const text = `#${person.id}`;
+      g.fillStyle = 'rgba(0,0,0,0.6)';
+      g.fillRect(x - 14, y - 9, 28, 18);
+      g.fillStyle = personCss(person.id);
+      g.fillText(text, x, y);
+      ++drawn;
+    }
+  }
+  body.dataset.peopleLabels = drawn;
+  body.dataset.peopleLabelsSeen = Math.max(Number(body.dataset.peopleLabelsSeen ?? 0), drawn);
 }
 
 const COUNTERS = [
@@ -118,11 +146,12 @@ function showFrame(frame, version) {
       row.insertCell().textContent = frame.counters[key];
     }
   }
+  showPeople(frame.people);
   if (frame.pose) setCurrentCamera(frame.pose);
   loadImages(frame, version);
 }
 
-for (const id of ['show-labels', 'show-regions', 'show-keypoints', 'show-search'])
+for (const id of ['show-labels', 'show-regions', 'show-keypoints', 'show-search', 'show-people'])
   $(id).addEventListener('change', () => lastFrame && drawMarks(lastFrame));
 
 // ---- the map --------------------------------------------------------------------------------
@@ -137,6 +166,7 @@ const layers = {
   truth: lineThrough([], 0x3db4e8),
   camera: new THREE.LineSegments(new THREE.BufferGeometry(),
                                  new THREE.LineBasicMaterial({ color: 0xff4d4d })),
+  people: new THREE.Group(),  // per person: a box of her extent and her recent track
 };
 Object.values(layers).forEach((layer) => view.world.add(layer));
 view.world.add(new THREE.AxesHelper(0.3));
@@ -161,6 +191,54 @@ function setKeyframes(poses, mapIds) {
     layers.keyframes.add(
         new THREE.LineSegments(geometry, keyframeMaterials[Number(id) % MAP_COLOURS.length]));
   }
+}
+
+// ---- people ---------------------------------------------------------------------------------
+// Recent positions per track id, as the frame snapshots brought them (the page sees every
+// snapshot, not every frame: the track is sampled at the viewer's interval).
+const TRACK_LENGTH = 120;
+const tracks = new Map();
+const idsSeen = new Set();
+
+function personObjects(person) {
+  const colour = new THREE.Color().setHSL(personHue(person.id) / 360, 0.85, 0.62);
+  const material = new THREE.LineBasicMaterial({ color: colour });
+  // Upright in SLAM's world (y down): as tall as her extent, half as wide and deep.
+  const size = Math.max(person.extent, 0.3);
+  const box = new THREE.LineSegments(
+      new THREE.EdgesGeometry(new THREE.BoxGeometry(size * 0.5, size, size * 0.5)), material);
+  box.position.set(...person.p);
+  box.userData.personId = person.id;
+  const track = new THREE.Line(new THREE.BufferGeometry().setFromPoints(tracks.get(person.id)),
+                               material);
+  return [box, track];
+}
+
+function showPeople(people) {
+  for (const child of layers.people.children) {
+    child.geometry.dispose();
+    child.material.dispose();  // shared by a box and its track: a second dispose does nothing
+  }
+  layers.people.clear();
+  const current = new Set(people.map((person) => person.id));
+  for (const id of [...tracks.keys()]) if (!current.has(id)) tracks.delete(id);
+  for (const person of people) {
+    const track = tracks.get(person.id) ?? [];
+    track.push(new THREE.Vector3(...person.p));
+    tracks.set(person.id, track.slice(-TRACK_LENGTH));
+    layers.people.add(...personObjects(person));
+    idsSeen.add(person.id);
+  }
+  const boxes = layers.people.children.filter((child) => child.userData.personId !== undefined);
+  $('people-count').textContent = boxes.length;
+  // Read from the three.js scene itself, so a test sees what is drawn, not what was received.
+  let inScene = 0;
+  view.scene.traverse((object) => { inScene += object.userData.personId !== undefined; });
+  window.liveScene = { ...window.liveScene, people: inScene };
+  body.dataset.people = boxes.length;
+  body.dataset.peopleSeen = Math.max(Number(body.dataset.peopleSeen ?? 0), boxes.length);
+  body.dataset.peopleIds = [...idsSeen].sort((a, b) => a - b).join(' ');
+  requestRender();
 }
 
 // The maps holding keyframes (id and keyframe count) and the merges so far. Maps are in
@@ -262,9 +340,10 @@ const visibility = () => {
   layers.covisibility.visible = $('show-covis').checked;
   layers.trajectory.visible = $('show-trajectory').checked;
   layers.truth.visible = $('show-truth').checked;
+  layers.people.visible = $('show-people').checked;
   requestRender();
 };
-for (const id of ['show-covis', 'show-trajectory', 'show-truth'])
+for (const id of ['show-covis', 'show-trajectory', 'show-truth', 'show-people'])
   $(id).addEventListener('change', visibility);
 view.world.updateMatrixWorld();
 // Drawn on demand, not every display frame: on a machine without a GPU the browser renders
@@ -280,6 +359,77 @@ function requestRender() {
 }
 view.controls.addEventListener('change', requestRender);
 window.addEventListener('resize', requestRender);
+
+// ---- the occupancy grid ---------------------------------------------------------------------
+// Offered only when the run builds the map (--occupancy); otherwise the tooltip says how. While
+// shown, the grid is asked for every few seconds (the server rebuilds it at most that often)
+// and drawn as a textured plane on the floor (grid frame: x, y on the floor, z up).
+const GRID_REFRESH_MS = 3000;
+let gridMesh = null;
+let gridVersion = 0;
+let gridTimer = null;
+
+function showOccupancyToggle(available) {
+  $('show-occupancy').disabled = !available;
+  $('occupancy-toggle').title = available
+      ? 'the 2D occupancy grid at floor height'
+      : 'start the run with --occupancy to build the occupancy map';
+  body.dataset.occupancy = available ? 'available' : 'off';
+}
+
+function placeGrid(grid, texture) {
+  const [w, h] = [grid.width * grid.resolution, grid.height * grid.resolution];
+  const geometry = new THREE.PlaneGeometry(w, h);
+  // The plane's centre in the grid frame, a millimetre above the floor so points on it show.
+  geometry.translate(grid.origin[0] + w / 2, grid.origin[1] + h / 2, 0.001);
+  const m = grid.T_world_grid;
+  geometry.applyMatrix4(new THREE.Matrix4().set(...m));
+  texture.magFilter = THREE.NearestFilter;
+  texture.colorSpace = THREE.SRGBColorSpace;
+  const material = new THREE.MeshBasicMaterial(
+      { map: texture, transparent: true, side: THREE.DoubleSide, depthWrite: false });
+  if (gridMesh) {
+    view.world.remove(gridMesh);
+    gridMesh.geometry.dispose();
+    gridMesh.material.map.dispose();
+    gridMesh.material.dispose();
+  }
+  gridMesh = new THREE.Mesh(geometry, material);
+  gridMesh.userData.occupancyGrid = true;
+  gridMesh.visible = $('show-occupancy').checked;
+  view.world.add(gridMesh);
+  let inScene = 0;
+  view.scene.traverse((object) => { inScene += object.userData.occupancyGrid === true; });
+  window.liveScene = { ...window.liveScene, grid: inScene };
+  body.dataset.gridCells = `${grid.cells.unknown} ${grid.cells.free} ${grid.cells.occupied}`;
+  body.dataset.gridVersion = grid.version;
+  requestRender();
+}
+
+async function loadGrid() {
+  try {
+    const response = await fetch('/api/live/grid');
+    if (!response.ok) return;  // no grid yet
+    const grid = await response.json();
+    if (grid.version === gridVersion) return;
+    gridVersion = grid.version;
+    const texture = await new THREE.TextureLoader().loadAsync(`/api/live/grid.png?v=${grid.version}`);
+    placeGrid(grid, texture);
+  } catch {
+    // The run ended and its server closed: the last grid shown stays.
+  }
+}
+
+$('show-occupancy').addEventListener('change', () => {
+  const on = $('show-occupancy').checked;
+  if (gridMesh) gridMesh.visible = on;
+  clearInterval(gridTimer);
+  if (on) {
+    loadGrid();
+    gridTimer = setInterval(loadGrid, GRID_REFRESH_MS);
+  }
+  requestRender();
+});
 
 // ---- state, controls and the event stream ---------------------------------------------------
 function showState(state) {
@@ -310,6 +460,7 @@ for (const action of ['pause', 'resume', 'step'])
 async function main() {
   const info = await (await fetch('/api/live/info')).json();
   $('title').textContent = info.title;
+  showOccupancyToggle(info.occupancy);
   const events = new EventSource('/api/live/events');
   events.onmessage = (message) => {
     const event = JSON.parse(message.data);

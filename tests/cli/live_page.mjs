@@ -1,7 +1,9 @@
 // Drives the live page of `pspslam run --viewer --viewer-paused` in headless chromium
 // (playwright-core from web/node_modules, Debian's /usr/bin/chromium) and prints what it saw as
 // one JSON line; test_cli (test_live_viewer.cpp) asserts on it. CHECK: `controls` (the default:
-// pause, step, toggles) or `atlas` (run to the end, the maps listed).
+// pause, step, toggles), `atlas` (run to the end, the maps listed) or `people` (run to the end,
+// the people drawn and labelled, the occupancy toggle's state) or `occupancy` (--occupancy: the
+// grid layer shown and its cells).
 // Usage: node live_page.mjs PLAYWRIGHT_CORE_DIR URL SCREENSHOT.png [CHECK]
 const [playwrightDir, url, screenshot, check = 'controls'] = process.argv.slice(2);
 const { chromium } = await import(`${playwrightDir}/index.mjs`);
@@ -172,11 +174,60 @@ async function watchAtlas(page) {
   seen.finished = true;
 }
 
+// Run to the end: the people the page received, the boxes in the 3D scene and the ids written
+// on the frame (the most seen at once), and whether the occupancy toggle is offered.
+async function watchPeople(page) {
+  await page.waitForFunction(held, null, { timeout: 60000 });
+  seen.occupancy_disabled = await page.evaluate(() => document.getElementById('show-occupancy').disabled);
+  seen.occupancy_tooltip = await page.evaluate(
+      () => document.getElementById('occupancy-toggle').title);
+  await page.click('#resume');
+  await page.waitForFunction(`Number(document.body.dataset.peopleSeen) > 0 &&
+                              Number(document.body.dataset.peopleLabelsSeen) > 0`,
+                             null, { timeout: 300000 });
+  await page.click('#pause');
+  await page.waitForFunction(held, null, { timeout: 60000 });
+  await settle();
+  const shown = await data(page);
+  seen.people_now = Number(shown.people);
+  seen.people_scene = await page.evaluate(() => window.liveScene.people);
+  await page.screenshot({ path: screenshot });
+  await page.click('#resume');
+  await page.waitForFunction(`document.body.dataset.runState === 'finished'`, null,
+                             { timeout: 300000 });
+  const end = await data(page);
+  seen.people_seen = Number(end.peopleSeen);
+  seen.people_labels_seen = Number(end.peopleLabelsSeen);
+  seen.people_ids = end.peopleIds.split(' ').map(Number);
+  seen.finished = true;
+}
+
+// --occupancy: the toggle is offered; switched on, the grid layer loads with known cells.
+async function watchOccupancy(page) {
+  await page.waitForFunction(held, null, { timeout: 60000 });
+  seen.occupancy_disabled = await page.evaluate(() => document.getElementById('show-occupancy').disabled);
+  await page.click('#show-occupancy');
+  await page.click('#resume');
+  const hasCells = `(document.body.dataset.gridCells ?? '0 0 0').split(' ').map(Number)
+                        .slice(1).every((n) => n > 0)`;
+  await page.waitForFunction(hasCells, null, { timeout: 300000 });
+  await settle();
+  const [unknown, free, occupied] = (await data(page)).gridCells.split(' ').map(Number);
+  Object.assign(seen, { grid_unknown: unknown, grid_free: free, grid_occupied: occupied });
+  seen.grid_meshes = await page.evaluate(() => window.liveScene?.grid ?? 0);
+  await page.screenshot({ path: screenshot });
+  await page.waitForFunction(`document.body.dataset.runState === 'finished'`, null,
+                             { timeout: 300000 });
+  seen.finished = true;
+}
+
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
   page.on('pageerror', (error) => { seen.page_error = String(error); });
   await page.goto(url);
   if (check === 'atlas') await watchAtlas(page);
+  else if (check === 'people') await watchPeople(page);
+  else if (check === 'occupancy') await watchOccupancy(page);
   else await pauseStepAndToggles(page);
 } catch (error) {
   seen.error = String(error);

@@ -7,12 +7,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
 #include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -238,6 +241,68 @@ TEST(CliLiveViewer, BrowserListsTheMapsOfTheAtlas) {
     SCOPED_TRACE("loop closing on: the second map merges into the first before the end");
     expect_page_lists_atlas(seq, "", 1);
   }
+}
+
+// The ids people.csv holds (column "id" of its header).
+std::set<int> csv_ids(const fs::path& file) {
+  std::ifstream stream(file);
+  std::string line;
+  std::getline(stream, line);
+  std::vector<std::string> header;
+  for (std::stringstream cells(line); std::getline(cells, line, ',');) header.push_back(line);
+  const auto column = std::find(header.begin(), header.end(), "id") - header.begin();
+  std::set<int> ids;
+  while (std::getline(stream, line)) {
+    std::stringstream cells(line);
+    for (long i = 0; std::getline(cells, line, ','); ++i)
+      if (i == column) ids.insert(std::stoi(line));
+  }
+  return ids;
+}
+
+// People from the sequence's own person masks: the page gets them with their ids, draws a box
+// per person in the 3D scene and writes the ids on the frame; without --occupancy the grid's
+// toggle is off and its tooltip names the flag.
+TEST(CliLiveViewer, BrowserShowsThePeople) {
+  if (const std::string missing = browser_missing(); !missing.empty()) GTEST_SKIP() << missing;
+  const fs::path seq = sequence(90);
+  LiveRun run(seq, "--viewer-paused --dynamic semantic --loop-closing off --semantic-masks " +
+                       (seq / "mask").string());
+  ASSERT_GT(run.port(), 0) << run.log();
+  const nlohmann::json seen =
+      watch_page(run.url(), testing::make_temp_dir("live_shot") / "people.png", "people");
+  ASSERT_FALSE(seen.contains("error")) << seen.dump() << "\n" << run.log();
+  EXPECT_FALSE(seen.contains("page_error")) << seen.dump();
+  ASSERT_TRUE(run.wait(120)) << run.log();
+
+  EXPECT_GT(seen["people_seen"].get<int>(), 0) << seen.dump();
+  EXPECT_GT(seen["people_labels_seen"].get<int>(), 0) << seen.dump();
+  // Held on a frame with people: the scene holds a box for each one the page counts.
+  EXPECT_GT(seen["people_now"].get<int>(), 0) << seen.dump();
+  EXPECT_EQ(seen["people_scene"], seen["people_now"]) << seen.dump();
+  const std::set<int> written = csv_ids(run.out() / "people.csv");
+  ASSERT_FALSE(written.empty()) << run.log();
+  for (const int id : seen["people_ids"].get<std::vector<int>>())
+    EXPECT_TRUE(written.contains(id)) << id << " is not in people.csv; " << seen.dump();
+  EXPECT_TRUE(seen["occupancy_disabled"].get<bool>()) << seen.dump();
+  EXPECT_TRUE(contains(seen["occupancy_tooltip"].get<std::string>(), "--occupancy")) << seen.dump();
+}
+
+// --occupancy: the toggle is offered, and the grid layer loads with free and occupied cells.
+TEST(CliLiveViewer, BrowserShowsTheOccupancyGrid) {
+  if (const std::string missing = browser_missing(); !missing.empty()) GTEST_SKIP() << missing;
+  const fs::path seq = sequence(90);
+  LiveRun run(seq, "--viewer-paused --dynamic off --loop-closing off --occupancy");
+  ASSERT_GT(run.port(), 0) << run.log();
+  const nlohmann::json seen =
+      watch_page(run.url(), testing::make_temp_dir("live_shot") / "occupancy.png", "occupancy");
+  ASSERT_FALSE(seen.contains("error")) << seen.dump() << "\n" << run.log();
+  EXPECT_FALSE(seen.contains("page_error")) << seen.dump();
+  ASSERT_TRUE(run.wait(120)) << run.log();
+  EXPECT_FALSE(seen["occupancy_disabled"].get<bool>()) << seen.dump();
+  EXPECT_GT(seen["grid_free"].get<int>(), 0) << seen.dump();
+  EXPECT_GT(seen["grid_occupied"].get<int>(), 0) << seen.dump();
+  EXPECT_EQ(seen["grid_meshes"], 1) << seen.dump();
 }
 
 TEST(CliLiveViewer, TraversalRefusedAndFloodDoesNotStallTracking) {

@@ -6,7 +6,9 @@
 #include <string>
 
 #include "pspslam/core/error.h"
+#include "pspslam/occupancy/occupancy_grid.h"
 #include "pspslam/viewer/endpoint.h"
+#include "pspslam/viewer/live_viewer.h"
 #include "pspslam/viewer/web_server.h"
 #include "support/test_support.h"
 
@@ -56,6 +58,54 @@ TEST(ViewerEndpoint, ParsesHostAndPort) {
   EXPECT_TRUE(is_loopback("localhost"));
   EXPECT_FALSE(is_loopback("0.0.0.0"));
   EXPECT_FALSE(is_loopback("192.168.1.2"));
+}
+
+// The live page's "people" elements: what live.js reads, rounded, and a null pixel for a person
+// not placed on the frame.
+TEST(ViewerLivePeople, PersonJson) {
+  TrackedPerson person;
+  person.id = 7;
+  person.position = {1.0, -0.5, 3.25};
+  person.velocity = {0.5, 0.0, -0.25};
+  person.extent_m = 1.234;
+  person.visible_pixels = 900;
+  const nlohmann::json placed = person_json({person, Eigen::Vector2d(320.04, 239.96)});
+  EXPECT_EQ(placed["id"], 7);
+  EXPECT_EQ(placed["p"], nlohmann::json({1.0, -0.5, 3.25}));
+  EXPECT_EQ(placed["v"], nlohmann::json({0.5, 0.0, -0.25}));
+  EXPECT_DOUBLE_EQ(placed["extent"].get<double>(), 1.23);
+  EXPECT_TRUE(placed["seen"].get<bool>());
+  EXPECT_EQ(placed["pixel"], nlohmann::json({320.0, 240.0}));
+  person.visible_pixels = 0;  // predicted only
+  const nlohmann::json coasting = person_json({person, std::nullopt});
+  EXPECT_FALSE(coasting["seen"].get<bool>());
+  EXPECT_TRUE(coasting["pixel"].is_null());
+}
+
+// The grid layer: counts and placement in the JSON, the picture upside down (an image's top row
+// is the grid's highest) with unknown cells clear.
+TEST(ViewerLiveGrid, JsonAndPicture) {
+  OccupancyGrid grid;
+  grid.resolution = 0.1;
+  grid.origin = {-1.0, 2.0};
+  grid.width = 3;
+  grid.height = 2;
+  grid.cells = {kGridOccupied, kGridFree, kGridUnknown, kGridFree, kGridFree, kGridUnknown};
+  grid.T_world_grid.translation() = Eigen::Vector3d(0.0, 1.5, 0.0);
+  const nlohmann::json json = grid_json(grid, 4);
+  EXPECT_EQ(json["version"], 4);
+  EXPECT_EQ(json["width"], 3);
+  EXPECT_EQ(json["height"], 2);
+  EXPECT_EQ(json["origin"], nlohmann::json({-1.0, 2.0}));
+  EXPECT_EQ(json["cells"], nlohmann::json({{"unknown", 2}, {"free", 3}, {"occupied", 1}}));
+  ASSERT_EQ(json["T_world_grid"].size(), 16u);
+  EXPECT_DOUBLE_EQ(json["T_world_grid"][7].get<double>(), 1.5);  // row-major: y translation
+  const cv::Mat picture = grid_picture(grid);
+  ASSERT_EQ(picture.size(), cv::Size(3, 2));
+  EXPECT_EQ(picture.at<cv::Vec4b>(1, 0)[3], 230);  // grid row 0 is the bottom image row
+  EXPECT_GT(picture.at<cv::Vec4b>(1, 1)[3], 0);
+  EXPECT_EQ(picture.at<cv::Vec4b>(1, 2)[3], 0);   // unknown: clear
+  EXPECT_EQ(picture.at<cv::Vec4b>(0, 0)[3], 90);  // free
 }
 
 TEST(ViewerAssets, OnlyFilesInsideTheFolder) {

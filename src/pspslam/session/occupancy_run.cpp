@@ -85,6 +85,11 @@ void OccupancyRun::add_keyframe(std::shared_ptr<const KeyFrame> keyframe, const 
   mapper_.add_keyframe(std::move(keyframe), depth, dynamic_mask);
 }
 
+OccupancyGrid OccupancyRun::live_grid() const {
+  if (mapper_.camera_centres().empty()) return {};
+  return grid(options_.grid);
+}
+
 OccupancyGrid OccupancyRun::grid(const GridOptions& band) const {
   OccupancyGrid grid;
   const std::vector<Eigen::Vector3d> cameras = mapper_.camera_centres();

@@ -48,6 +48,9 @@ class OccupancyRun {
   // After the system has shut down: the final map, the exports and the scores (keyframes: the
   // final keyframe trajectory, for the alignment to the truth). Prints a line per output.
   void finish(const Trajectory& keyframes, std::ostream& out);
+  // The 2D grid of the map as it is now, under the map's lock (any thread; the live viewer's
+  // layer). Empty (width 0) while the map holds nothing.
+  OccupancyGrid live_grid() const;
   // stats.json's "occupancy" member (after finish()).
   const nlohmann::ordered_json& json() const { return json_; }
   // The 2D grid over this band of the map as it stands (the final map after finish()).

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 
+#include "pspslam/camera/pinhole_camera.h"
 #include "pspslam/core/types.h"
 #include "pspslam/session/run_statistics.h"
 #include "pspslam/system/system.h"
@@ -9,6 +10,7 @@
 namespace pspslam {
 
 struct InputFrame;
+class OccupancyRun;
 
 // One processed frame as a watcher of the run sees it, on the run loop's thread; everything is
 // valid only during RunObserver::frame_done().
@@ -20,6 +22,11 @@ struct FrameView {
   const MappingStats& mapping;
   const Trajectory& estimate;  // every pose computed so far
   size_t frames_total = 0;     // 0: unknown (a live camera)
+  // The intrinsics the frame was tracked with (people are placed on the frame through them);
+  // null when unknown.
+  const PinholeCamera* camera = nullptr;
+  // --occupancy: the map being built (thread-safe to read); valid until run_ended() returns.
+  const OccupancyRun* occupancy = nullptr;
 };
 
 // Someone watching a run as it goes (the live viewer, viewer/live_viewer.h). Called on the run

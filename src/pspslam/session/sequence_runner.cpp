@@ -186,7 +186,8 @@ void SequenceRunner::feed_frames(ProgressBar& progress, StartWatch& start_watch)
     progress.update(statistics_.processed(), statistics_.realtime_dropped());
     if (observer_) {
       const double cpu_before = thread_cpu_ms();
-      observer_->frame_done({frame, report, *system_, statistics_, mapping, estimate_, frames_});
+      observer_->frame_done({frame, report, *system_, statistics_, mapping, estimate_, frames_,
+                             &input_.config.camera.pinhole, occupancy_.get()});
       statistics_.observer_cpu_ms.push_back(observer_cpu + thread_cpu_ms() - cpu_before);
     }
   }

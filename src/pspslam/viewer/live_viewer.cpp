@@ -23,7 +23,9 @@
 #include "pspslam/map/keyframe.h"
 #include "pspslam/map/map.h"
 #include "pspslam/map/map_point.h"
+#include "pspslam/occupancy/occupancy_grid.h"
 #include "pspslam/semantic/overlay.h"
+#include "pspslam/session/occupancy_run.h"
 
 namespace pspslam {
 
@@ -41,6 +43,7 @@ struct LiveViewer::FrameSnapshot {
   TrackResult tracking;
   double extraction_ms = 0.0, tracking_ms = 0.0, local_ba_ms = 0.0;
   DynamicReport dynamic;
+  std::vector<ShownPerson> people;
   MappingStats mapping;
   size_t processed = 0, lost = 0, relocalisations = 0, dropped = 0, masked = 0, tested_total = 0,
          dynamic_total = 0, culled = 0, without_mask = 0;
@@ -60,6 +63,24 @@ struct LiveViewer::MapSnapshot {
 namespace {
 
 using nlohmann::json;
+
+// The people of a frame with the pixel each one's centre projects to (none: no pose, no
+// intrinsics, or behind the camera), so the page can write the ids on the frame.
+std::vector<ShownPerson> shown_people(const FrameView& view) {
+  std::vector<ShownPerson> shown;
+  const std::optional<Pose>& pose = view.report.tracking.T_world_camera;
+  for (const TrackedPerson& person : view.report.people.people) {
+    ShownPerson& s = shown.emplace_back(ShownPerson{person, std::nullopt});
+    if (!pose || !view.camera) continue;
+    const Eigen::Vector3d in_camera = pose->inverse() * person.position;
+    if (in_camera.z() > 0.05) s.pixel = view.camera->project(in_camera);
+  }
+  return shown;
+}
+
+json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+double round2(double value) { return std::round(value * 100.0) / 100.0; }
 
 // Covisibility edges drawn: the strong ones only, or the graph hides the map (ORB-SLAM2's viewer
 // draws weight >= 100; synthetic and Bonn keyframes share fewer points, hence lower).
@@ -121,6 +142,47 @@ cv::Mat region_picture(const cv::Mat& regions, cv::Size size) {
 
 }  // namespace
 
+cv::Mat grid_picture(const OccupancyGrid& grid) {
+  cv::Mat picture(grid.height, grid.width, CV_8UC4, cv::Scalar::all(0));
+  for (int row = 0; row < grid.height; ++row) {
+    cv::Vec4b* out = picture.ptr<cv::Vec4b>(grid.height - 1 - row);
+    for (int column = 0; column < grid.width; ++column) {
+      const std::int8_t cell = grid.at(column, row);
+      if (cell == kGridFree) out[column] = {230, 230, 230, 90};     // BGRA
+      if (cell == kGridOccupied) out[column] = {40, 40, 200, 230};  // dark red
+    }
+  }
+  return picture;
+}
+
+nlohmann::json grid_json(const OccupancyGrid& grid, std::uint64_t version) {
+  json pose = json::array();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) pose.push_back(grid.T_world_grid.matrix()(r, c));
+  return {{"version", version},
+          {"width", grid.width},
+          {"height", grid.height},
+          {"resolution", grid.resolution},
+          {"origin", {grid.origin.x(), grid.origin.y()}},
+          {"T_world_grid", std::move(pose)},
+          {"cells",
+           {{"unknown", grid.count(kGridUnknown)},
+            {"free", grid.count(kGridFree)},
+            {"occupied", grid.count(kGridOccupied)}}}};
+}
+
+nlohmann::json person_json(const ShownPerson& shown) {
+  const TrackedPerson& p = shown.person;
+  json pixel;
+  if (shown.pixel) pixel = {round1(shown.pixel->x()), round1(shown.pixel->y())};
+  return {{"id", p.id},
+          {"p", vector_json(p.position)},
+          {"v", vector_json(p.velocity)},
+          {"extent", round2(p.extent_m)},
+          {"seen", p.visible_pixels > 0},
+          {"pixel", std::move(pixel)}};
+}
+
 LiveViewer::LiveViewer(LiveViewerOptions options)
     : options_(std::move(options)), server_(options_.web_root, "live.html") {
   paused_ = options_.start_paused && !options_.realtime;
@@ -144,13 +206,16 @@ LiveViewer::LiveViewer(LiveViewerOptions options)
   server_.get("/api/live/labels.png", shared_reply(&LiveViewer::labels_png_, "image/png"));
   server_.get("/api/live/regions.png", shared_reply(&LiveViewer::regions_png_, "image/png"));
   server_.get("/api/live/map", shared_reply(&LiveViewer::map_json_, "application/json"));
+  server_.get("/api/live/grid", shared_reply(&LiveViewer::grid_json_, "application/json"));
+  server_.get("/api/live/grid.png", shared_reply(&LiveViewer::grid_png_, "image/png"));
   server_.get("/api/live/info", [this](const WebServer::Query&) {
     return HttpReply{200, "application/json",
                      share(json{{"title", options_.title},
                                 {"realtime", options_.realtime},
                                 {"interval_ms", options_.interval.count()},
                                 {"map_interval_ms", options_.map_interval.count()},
-                                {"ground_truth", options_.ground_truth.string()}}
+                                {"ground_truth", options_.ground_truth.string()},
+                                {"occupancy", options_.occupancy}}
                                .dump())};
   });
   server_.get("/api/live/state", [this](const WebServer::Query&) {
@@ -212,6 +277,10 @@ void LiveViewer::frame_done(const FrameView& view) {
     pending_frame_ = std::move(frame);  // newest wins: an older one not yet encoded is dropped
     last_frame_snapshot_ = now;
   }
+  if (view.occupancy && !ended_ && now - last_grid_ >= options_.grid_interval) {
+    pending_grid_ = view.occupancy;
+    last_grid_ = now;
+  }
   if (map) {
     pending_map_ = std::move(map);
     last_map_snapshot_ = now;
@@ -249,6 +318,7 @@ std::unique_ptr<LiveViewer::FrameSnapshot> LiveViewer::snapshot_frame(const Fram
   s.local_ba_ms =
       view.statistics.local_mapping_ms.empty() ? 0.0 : view.statistics.local_mapping_ms.back();
   s.dynamic = view.report.dynamic;
+  s.people = shown_people(view);
   s.mapping = view.mapping;
   const RunStatistics& st = view.statistics;
   s.processed = st.processed();
@@ -311,11 +381,13 @@ void LiveViewer::hold(std::unique_lock<std::mutex>& lock, size_t frame_index) {
 }
 
 void LiveViewer::run_ended() {
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_);
   ended_ = true;
   paused_ = false;
+  pending_grid_ = nullptr;
   ++event_;
   changed_.notify_all();
+  changed_.wait(lock, [this] { return !grid_busy_; });
 }
 
 bool LiveViewer::pause() {
@@ -366,6 +438,7 @@ std::string LiveViewer::state_json() const {
               {"realtime", options_.realtime},
               {"frame_version", frame_version_},
               {"map_version", map_version_},
+              {"grid_version", grid_version_},
               {"pages", server_.open_event_streams()}}
       .dump();
 }
@@ -391,14 +464,22 @@ std::string LiveViewer::event_json() const {
 void LiveViewer::encode_loop() {
   std::unique_lock lock(mutex_);
   while (true) {
-    work_.wait(lock, [this] { return closing_ || pending_frame_ || pending_map_; });
+    work_.wait(lock,
+               [this] { return closing_ || pending_frame_ || pending_map_ || pending_grid_; });
     if (closing_) return;
     std::unique_ptr<FrameSnapshot> frame = std::move(pending_frame_);
     std::unique_ptr<MapSnapshot> map = std::move(pending_map_);
+    const OccupancyRun* grid = std::exchange(pending_grid_, nullptr);
+    grid_busy_ = grid != nullptr;
     lock.unlock();
     if (frame) publish_frame(*frame);
     if (map) publish_map(*map);
+    if (grid) publish_grid(*grid);
     lock.lock();
+    if (grid) {
+      grid_busy_ = false;
+      changed_.notify_all();
+    }
   }
 }
 
@@ -455,6 +536,8 @@ std::string LiveViewer::frame_json(const FrameSnapshot& s, bool labels, bool reg
   for (const cv::Point2f& node : s.path) path.push_back({round1(node.x), round1(node.y)});
 
   const DynamicReport& d = s.dynamic;
+  json people = json::array();
+  for (const ShownPerson& shown : s.people) people.push_back(person_json(shown));
   const json frame = {
       {"index", s.index},
       {"timestamp", s.timestamp},
@@ -472,6 +555,7 @@ std::string LiveViewer::frame_json(const FrameSnapshot& s, bool labels, bool reg
       {"fates", fates},
       {"tested", std::move(tested)},
       {"path", std::move(path)},
+      {"people", std::move(people)},
       {"labels", labels},
       {"regions", regions},
       {"timing",
@@ -545,6 +629,23 @@ void LiveViewer::publish_map(const MapSnapshot& s) {
   std::lock_guard lock(mutex_);
   map_json_ = std::move(text);
   ++map_version_;
+  ++event_;
+  changed_.notify_all();
+}
+
+void LiveViewer::publish_grid(const OccupancyRun& occupancy) {
+  OccupancyGrid grid;
+  try {
+    grid = occupancy.live_grid();
+  } catch (const std::exception& e) {
+    spdlog::debug("viewer: no occupancy grid yet: {}", e.what());
+    return;
+  }
+  if (grid.width == 0 || grid.height == 0) return;
+  auto png = encode(".png", grid_picture(grid), {cv::IMWRITE_PNG_COMPRESSION, 3});
+  std::lock_guard lock(mutex_);
+  grid_png_ = std::move(png);
+  grid_json_ = share(grid_json(grid, ++grid_version_).dump());
   ++event_;
   changed_.notify_all();
 }

@@ -11,12 +11,36 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
 #include "pspslam/core/types.h"
+#include "pspslam/people/people_tracker.h"
 #include "pspslam/session/keypoint_overlay.h"
 #include "pspslam/session/run_observer.h"
 #include "pspslam/viewer/web_server.h"
 
 namespace pspslam {
+
+// A tracked person as the page shows her: in the 3D view at her world position, on the frame at
+// the pixel her centre projects to (none: no pose or intrinsics, or behind the camera).
+struct ShownPerson {
+  TrackedPerson person;
+  std::optional<Eigen::Vector2d> pixel;
+};
+
+class OccupancyRun;
+struct OccupancyGrid;
+
+// The grid layer of the page: the grid's cells as an RGBA picture (top row: the grid's highest
+// row, as an image is shown; unknown clear, free pale, occupied dark red) and its placement and
+// counts as JSON (width, height, resolution, origin, T_world_grid row-major, cells).
+cv::Mat grid_picture(const OccupancyGrid& grid);
+nlohmann::json grid_json(const OccupancyGrid& grid, std::uint64_t version);
+
+// One element of the frame JSON's "people" array: id, p (world position), v (velocity),
+// extent (metres), seen (observed in this frame, not only predicted), pixel ([u, v] or null).
+nlohmann::json person_json(const ShownPerson& shown);
 
 struct LiveViewerOptions {
   std::string endpoint = "127.0.0.1:8080";  // --viewer [HOST:]PORT
@@ -25,6 +49,9 @@ struct LiveViewerOptions {
   // loop pays for the viewer is bounded by these, not by how often a browser asks.
   std::chrono::milliseconds interval{250};
   std::chrono::milliseconds map_interval{1000};
+  // The occupancy grid (--occupancy) is rebuilt from the OctoMap at most this often, on the
+  // viewer's thread: a grid costs a pass over the map, the frames need none of it.
+  std::chrono::milliseconds grid_interval{3000};
   int image_width = 480;  // frames are sent JPEG at this width (never enlarged)
   bool start_paused = false;
   // A real-time feed keeps coming whatever the viewer does: pause is refused (the frames would
@@ -35,6 +62,7 @@ struct LiveViewerOptions {
   std::filesystem::path ground_truth;  // TUM file aligned onto the estimate; empty: none
   OverlayClasses classes;              // the segmentation's classes, for the label colours
   std::string title;                   // the sequence or camera, shown on the page
+  bool occupancy = false;              // --occupancy: the page offers the grid layer
 };
 
 // `pspslam run --viewer`: serves the live page (web/live.html) and what it shows, a snapshot of
@@ -81,6 +109,7 @@ class LiveViewer final : public RunObserver {
   // The frame's JSON for the page; `labels` and `regions`: their pictures were encoded.
   std::string frame_json(const FrameSnapshot& snapshot, bool labels, bool regions) const;
   void publish_map(const MapSnapshot& snapshot);
+  void publish_grid(const OccupancyRun& occupancy);
   std::string state_json() const;  // under mutex_
   std::string event_json() const;  // under mutex_: state + the newest frame's JSON
   std::optional<std::string> next_event(std::uint64_t& last);
@@ -96,6 +125,11 @@ class LiveViewer final : public RunObserver {
   std::condition_variable changed_;  // event streams and the paused run loop
   std::unique_ptr<FrameSnapshot> pending_frame_;
   std::unique_ptr<MapSnapshot> pending_map_;
+  // The occupancy map to make a grid of (pending), and whether the encoder is reading it:
+  // run_ended() waits for that read, as the map goes when the run loop returns.
+  const OccupancyRun* pending_grid_ = nullptr;
+  bool grid_busy_ = false;
+  Clock::time_point last_grid_{};
   bool closing_ = false;
   // Control state.
   bool paused_ = false;
@@ -113,6 +147,8 @@ class LiveViewer final : public RunObserver {
   std::uint64_t frame_version_ = 0;
   std::uint64_t map_version_ = 0;
   std::shared_ptr<const std::string> frame_json_, jpeg_, labels_png_, regions_png_, map_json_;
+  std::shared_ptr<const std::string> grid_json_, grid_png_;
+  std::uint64_t grid_version_ = 0;
   // fps over the snapshots: frames processed between two of them over the time between.
   std::optional<std::pair<size_t, Clock::time_point>> fps_reference_;
   double fps_ = 0.0;

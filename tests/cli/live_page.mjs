@@ -86,6 +86,7 @@ async function pauseStepAndToggles(page) {
   const covisPixels = () => colourPixels(page, [0x3a, 0x9d, 0x54]);  // the edges' green
   seen.marks_on = await marks();
   await page.click('#show-keypoints');
+  await page.click('#show-people');  // the people's ids are drawn on the same canvas
   await settle();
   seen.marks_keypoints_off = await marks();
   await page.click('#show-search');
@@ -93,6 +94,7 @@ async function pauseStepAndToggles(page) {
   seen.marks_search_only = await marks();
   await page.click('#show-keypoints');
   await page.click('#show-search');
+  await page.click('#show-people');
   await settle();
   seen.marks_back = await marks();
   seen.labels_shown = await display('labels');

@@ -152,9 +152,9 @@ TEST(CliLiveViewer, BrowserWatchesPausesAndStepsTheRun) {
   // for a map with covisibility edges before it pauses, so the edge toggle has something to hide.
   EXPECT_GT(seen["covisibility_edges"].get<int>(), 0);
   EXPECT_GT(seen["dynamic_seen"].get<int>(), 0);
-  // The toggles (on held frames): keypoints off leaves the canvas empty (the ant path is off by
-  // default), the ant path alone draws something, both back give the same picture; the label
-  // overlay hides and the covisibility edges disappear from the 3D view and come back.
+  // The toggles (on held frames): keypoints and people's ids off leave the canvas empty (the ant
+  // path is off by default), the ant path alone draws something, both back give the same picture;
+  // the label overlay hides and the covisibility edges disappear from the 3D view and come back.
   EXPECT_GT(seen["marks_on"].get<int>(), 100);
   EXPECT_EQ(seen["marks_keypoints_off"], 0);
   EXPECT_GT(seen["marks_search_only"].get<int>(), 0);

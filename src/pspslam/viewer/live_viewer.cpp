@@ -277,6 +277,7 @@ void LiveViewer::frame_done(const FrameView& view) {
     pending_frame_ = std::move(frame);  // newest wins: an older one not yet encoded is dropped
     last_frame_snapshot_ = now;
   }
+  if (view.occupancy) last_occupancy_ = view.occupancy;
   if (view.occupancy && !ended_ && now - last_grid_ >= options_.grid_interval) {
     pending_grid_ = view.occupancy;
     last_grid_ = now;
@@ -388,6 +389,11 @@ void LiveViewer::run_ended() {
   ++event_;
   changed_.notify_all();
   changed_.wait(lock, [this] { return !grid_busy_; });
+  // The grid as the run left it, published here while the map still exists: a run (or its last
+  // stretch) shorter than the refresh interval would otherwise leave the page an older grid.
+  const OccupancyRun* occupancy = std::exchange(last_occupancy_, nullptr);
+  lock.unlock();
+  if (occupancy) publish_grid(*occupancy);
 }
 
 bool LiveViewer::pause() {

@@ -128,6 +128,7 @@ class LiveViewer final : public RunObserver {
   // The occupancy map to make a grid of (pending), and whether the encoder is reading it:
   // run_ended() waits for that read, as the map goes when the run loop returns.
   const OccupancyRun* pending_grid_ = nullptr;
+  const OccupancyRun* last_occupancy_ = nullptr;  // the run's map, for the grid at its end
   bool grid_busy_ = false;
   Clock::time_point last_grid_{};
   bool closing_ = false;

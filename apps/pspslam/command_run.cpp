@@ -181,7 +181,7 @@ std::unique_ptr<LiveViewer> start_viewer(const RunFlags& flags, const SystemOpti
   live.start_paused = flags.viewer_paused;
   live.realtime = flags.settings.realtime;
   live.classes = overlay_classes(system.dynamic);
-  live.occupancy = occupancy_options(flags.occupancy).enabled;
+  live.occupancy = occupancy_options(flags.occupancy, flags.settings).enabled;
   live.title = !flags.video.empty()   ? "video " + flags.video
                : flags.camera.empty() ? flags.sequence
                                       : "camera " + flags.camera;

@@ -169,7 +169,7 @@ def run_command(experiment, cell, variant, prepared, cli, setup):
                  "--dilation", "0"] + model + variant.flags)
     flags = [flag.replace("{sequence}", str(prepared.folder)) for flag in variant.flags]
     command = [str(cli), "-q", "run", "--sequence", str(prepared.folder), "--dynamic",
-               experiment.mode_of(cell, variant)] + flags
+               experiment.mode_of(cell, variant)] + flags + cell.args
     limits = [n for n in (prepared.max_frames, setup.limit_frames) if n]
     if limits:
         command += ["--max-frames", str(min(limits))]

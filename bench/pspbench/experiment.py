@@ -229,6 +229,8 @@ def _read_cell(fields, kind):
                 stretches=_read_stretches(fields), split=fields.get("split", str),
                 split_key=fields.get("split_key", str, "val"),
                 args=fields.get_list("args", str), mode=fields.get_choice("mode", MODES))
+    if cell.args and kind == "segment":
+        raise fields.error("args", "not allowed in a kind = \"segment\" experiment")
     if cell.reencode_jpeg > 100:
         raise fields.error("reencode_jpeg", f"a JPEG quality is 1-100, got {cell.reencode_jpeg}")
     seeds = fields.get_list("seeds", int)

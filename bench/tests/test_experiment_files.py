@@ -82,3 +82,14 @@ def test_config_keys_are_set_in_place():
         sequences.set_config_key(text, "camera.no_such_key", 1)
     with pytest.raises(KeyError):
         sequences.set_config_key(text, "depth_factor", 1)
+
+
+def test_a_cell_s_args_reach_its_runs(tmp_path):
+    """A monocular cell among RGB-D ones: its own flags follow the variant's on the command."""
+    path = tmp_path / "cells.toml"
+    path.write_text("title = 'Cells'\n[variants.full]\nmode = 'full'\nflags = ['--mask-margin', "
+                    "'3']\n" + CELL + "args = ['--sensor', 'monocular']\n")
+    completed = subprocess.run([sys.executable, str(RUNNER), "run", str(path), "--dry-run",
+                                "--work", str(tmp_path / "work")], capture_output=True, text=True)
+    assert completed.returncode == 0, completed.stderr
+    assert "--dynamic full --mask-margin 3 --sensor monocular" in completed.stdout

@@ -17,8 +17,9 @@ command that regenerates it (from the repository's root), the commit measured, t
 load. The measurements behind a decision are in its record ([decisions/](decisions/README.md)).
 ATE is the RMSE of camera positions after rigid alignment (SE(3); Sim(3) for a monocular
 run), in mm, `pspslam eval`; *online* is `trajectory.txt` (each frame as tracked), *final* is
-`trajectory_refined.txt` (frames moved with the keyframes after bundle adjustment). Beside each
-ATE: poses evaluated / frames processed.
+`trajectory_refined.txt` (frames moved with the keyframes after bundle adjustment; the file to
+evaluate: [decision](decisions/file-to-evaluate.md)). Beside each ATE: poses evaluated / frames
+processed.
 """
 
 

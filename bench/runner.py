@@ -10,6 +10,7 @@ experiments that share a run share its result.
 """
 import argparse
 import concurrent.futures
+import importlib.util
 import os
 import platform
 import shlex
@@ -376,6 +377,9 @@ def write_report(args, experiment, setup, table, executor_text, counts, loads):
         link = os.path.relpath(image, results_file.parent)
     else:
         image.unlink(missing_ok=True)  # an older run's picture would not match the tables
+        if importlib.util.find_spec("matplotlib") is None:
+            log(f"no picture for '{experiment.name}': {sys.executable} has no matplotlib "
+                "(run bench/runner.py itself: its first line names /usr/bin/python3)")
     text = report.section(
         experiment, lines,
         provenance(args, experiment, setup, executor_text, counts, loads, table), link)
